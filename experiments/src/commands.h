@@ -1,0 +1,14 @@
+// The fovea command line: one function per subcommand, registered on CLI11.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <functional>
+
+namespace experiments {
+
+/// Each registers its subcommand on `app` and sets `*run` to the action to
+/// perform when that subcommand is chosen.
+void AddRenderCommand(CLI::App& app, std::function<int()>* run);
+void AddBenchCommand(CLI::App& app, std::function<int()>* run);
+
+}  // namespace experiments

@@ -1,0 +1,36 @@
+// Projective geometry on rig camera models (OpenCV frames, metres, pixels).
+#pragma once
+
+#include <Eigen/Geometry>
+#include <optional>
+
+#include "rig/types.h"
+
+namespace fovea {
+
+/// Pixel where the world point p_W appears in a camera at world_T_camera;
+/// nullopt if the point is behind or on the camera plane.
+std::optional<Eigen::Vector2d> ProjectWorldPoint(const Eigen::Isometry3d& world_T_camera,
+                                                 const rig::CameraIntrinsics& intrinsics,
+                                                 const Eigen::Vector3d& p_W);
+
+/// A ray in the world: origin and unit direction.
+struct Ray {
+  Eigen::Vector3d origin_W;
+  Eigen::Vector3d direction_W;
+};
+
+/// The world ray through pixel uv of a camera.
+Ray PixelRay(const Eigen::Isometry3d& world_T_camera, const rig::CameraIntrinsics& intrinsics,
+             const Eigen::Vector2d& uv);
+
+/// Midpoint of the shortest segment between two rays, and that segment's
+/// length (the rays' miss distance). nullopt for (near) parallel rays or a
+/// point behind either camera.
+struct Triangulation {
+  Eigen::Vector3d p_W;
+  double miss_distance_m = 0;
+};
+std::optional<Triangulation> TriangulateMidpoint(const Ray& a, const Ray& b);
+
+}  // namespace fovea

@@ -1,0 +1,58 @@
+// What only a simulator can know: true depth, exact ray casts, which surface
+// a pixel shows. Used by experiments/ and tests, never by fovea/.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <string>
+
+#include "rig/types.h"
+
+namespace sim {
+
+struct World;
+
+/// A ray's first hit on a visible scene surface (geom groups 0 to 2; the rig's
+/// own geoms are never hit).
+struct RayHit {
+  double distance_m = 0;  ///< along the unit ray direction
+  int geom_id = -1;
+  Eigen::Vector3d point_W = Eigen::Vector3d::Zero();
+};
+
+/// An image and its true depth seen by a virtual camera.
+struct TrueView {
+  cv::Mat bgr;      ///< CV_8UC3; empty unless asked for
+  cv::Mat depth_m;  ///< CV_32FC1, planar depth (camera z) in metres; 0 where nothing is hit
+};
+
+class GroundTruth {
+ public:
+  explicit GroundTruth(World* world) : world_(world) {}
+
+  /// Renders the scene (OpenGL depth buffer converted to metres with the
+  /// model's near and far planes) from an arbitrary camera pose. The
+  /// intrinsics must be undistorted with square pixels, a centred principal
+  /// point and a size no larger than the rig's images; throws rig::RigError
+  /// otherwise.
+  TrueView Render(const Eigen::Isometry3d& world_T_camera, const rig::CameraIntrinsics& intrinsics,
+                  bool color = false) const;
+
+  /// Exact per-pixel ray casting: planar depth in metres (0 where nothing is
+  /// hit) and, if `geom_ids` is given, the hit geom per pixel (CV_32SC1, -1
+  /// where nothing is hit). Any intrinsics, distortion included.
+  cv::Mat RayCastDepth(const Eigen::Isometry3d& world_T_camera,
+                       const rig::CameraIntrinsics& intrinsics, cv::Mat* geom_ids = nullptr) const;
+
+  /// First hit of the ray from p_W along dir_W (any non-zero length).
+  std::optional<RayHit> CastRay(const Eigen::Vector3d& p_W, const Eigen::Vector3d& dir_W) const;
+
+  /// The geom's name, or "geom<N>" for an unnamed one.
+  std::string GeomName(int geom_id) const;
+
+ private:
+  World* world_;
+};
+
+}  // namespace sim

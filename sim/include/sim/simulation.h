@@ -1,0 +1,56 @@
+// A scene loaded with the simulated TAVT in it: the rig (behind rig::Rig) and
+// the ground truth, sharing one MuJoCo model.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rig/rig.h"
+#include "sim/config.h"
+#include "sim/ground_truth.h"
+
+namespace sim {
+
+/// Supplies the bytes of an asset file a scene names (for instance a
+/// procedural texture) by its file name without directory; returns nullopt
+/// for names it does not know, which MuJoCo then reads from disk.
+using AssetProvider = std::function<std::optional<std::vector<uint8_t>>(const std::string& name)>;
+
+/// Name under which scenes include the rig model: <include file="tavt.xml"/>.
+inline constexpr const char* kRigIncludeName = "tavt.xml";
+
+/// MJCF text of the TAVT for a configuration (what a scene's include reads).
+std::string RigMjcf(const SimRigConfig& config);
+
+class SimRig;
+
+class Simulation {
+ public:
+  /// Loads an MJCF scene file that includes the rig model. Throws SceneError
+  /// (one line naming the file and the problem) if the file cannot be read or
+  /// parsed, or lacks the rig; throws SceneError if `config` is invalid.
+  static std::unique_ptr<Simulation> Load(const std::string& scene_path,
+                                          const SimRigConfig& config,
+                                          const AssetProvider& assets = {});
+  ~Simulation();
+  Simulation(const Simulation&) = delete;
+  Simulation& operator=(const Simulation&) = delete;
+
+  rig::Rig& rig();
+  const GroundTruth& truth() const;
+  const SimRigConfig& config() const;
+  const std::string& scene_path() const;
+
+ private:
+  Simulation();
+  std::unique_ptr<World> world_;
+  std::unique_ptr<SimRig> rig_;
+  std::unique_ptr<GroundTruth> truth_;
+  SimRigConfig config_;
+};
+
+}  // namespace sim

@@ -1,0 +1,100 @@
+#include <cstring>
+#include <opencv2/core.hpp>
+
+#include "sim/config.h"
+#include "world.h"
+
+namespace sim {
+
+OffscreenRenderer::OffscreenRenderer(const mjModel* m, int width_px, int height_px)
+    : width_px_(width_px), height_px_(height_px) {
+  context_ = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, nullptr);
+  if (!context_) throw SceneError("cannot create an OSMesa rendering context");
+  window_buffer_.resize(static_cast<size_t>(width_px) * height_px * 4);
+  if (!OSMesaMakeCurrent(context_, window_buffer_.data(), GL_UNSIGNED_BYTE, width_px, height_px)) {
+    OSMesaDestroyContext(context_);
+    throw SceneError("cannot make the OSMesa rendering context current");
+  }
+  mjv_defaultScene(&scene_);
+  mjv_makeScene(m, &scene_, 2000);
+  mjv_defaultOption(&option_);
+  // Groups 0-2 are the scene; 3-5 hold the rig's own geoms, never imaged.
+  for (int g = 0; g < mjNGROUP; ++g) option_.geomgroup[g] = g < 3 ? 1 : 0;
+  mjr_defaultContext(&context_mj_);
+  mjr_makeContext(m, &context_mj_, mjFONTSCALE_100);
+  mjr_setBuffer(mjFB_OFFSCREEN, &context_mj_);
+  if (context_mj_.offWidth < width_px || context_mj_.offHeight < height_px) {
+    throw SceneError("offscreen buffer " + std::to_string(context_mj_.offWidth) + "x" +
+                     std::to_string(context_mj_.offHeight) + " is smaller than the images");
+  }
+}
+
+OffscreenRenderer::~OffscreenRenderer() {
+  OSMesaMakeCurrent(context_, window_buffer_.data(), GL_UNSIGNED_BYTE, width_px_, height_px_);
+  mjr_freeContext(&context_mj_);
+  mjv_freeScene(&scene_);
+  OSMesaDestroyContext(context_);
+}
+
+void OffscreenRenderer::Render(const mjModel* m, mjData* d, int cam_id, int width_px,
+                               int height_px, cv::Mat* rgb, cv::Mat* depth_m) {
+  // Several renderers may live in one process (tests): make ours current.
+  OSMesaMakeCurrent(context_, window_buffer_.data(), GL_UNSIGNED_BYTE, width_px_, height_px_);
+  mjr_setBuffer(mjFB_OFFSCREEN, &context_mj_);
+  mjvCamera camera;
+  mjv_defaultCamera(&camera);
+  camera.type = mjCAMERA_FIXED;
+  camera.fixedcamid = cam_id;
+  mjv_updateScene(m, d, &option_, nullptr, &camera, mjCAT_ALL, &scene_);
+  const mjrRect viewport = {0, 0, width_px, height_px};
+  mjr_render(viewport, &scene_, &context_mj_);
+
+  cv::Mat rgb_up, depth_up;
+  if (rgb) rgb_up.create(height_px, width_px, CV_8UC3);
+  if (depth_m) depth_up.create(height_px, width_px, CV_32FC1);
+  mjr_readPixels(rgb ? rgb_up.ptr<unsigned char>() : nullptr,
+                 depth_m ? depth_up.ptr<float>() : nullptr, viewport, &context_mj_);
+  // OpenGL returns the bottom row first.
+  if (rgb) cv::flip(rgb_up, *rgb, 0);
+  if (depth_m) {
+    // Window depth d in [0, 1] to planar depth: z = near / (1 - d (1 - near / far)).
+    const double extent = m->stat.extent;
+    const double near_m = m->vis.map.znear * extent, far_m = m->vis.map.zfar * extent;
+    depth_m->create(height_px, width_px, CV_32FC1);
+    for (int r = 0; r < height_px; ++r) {
+      const float* src = depth_up.ptr<float>(height_px - 1 - r);
+      float* dst = depth_m->ptr<float>(r);
+      for (int c = 0; c < width_px; ++c) {
+        const double w = src[c];
+        dst[c] = w >= 1.0 ? 0.0f : static_cast<float>(near_m / (1.0 - w * (1.0 - near_m / far_m)));
+      }
+    }
+  }
+}
+
+World::~World() {
+  delete renderer;
+  if (d) mj_deleteData(d);
+  if (m) mj_deleteModel(m);
+}
+
+Eigen::Isometry3d CameraPoseFromMujoco(const mjData* d, int cam_id) {
+  Eigen::Isometry3d world_T_camera = Eigen::Isometry3d::Identity();
+  Eigen::Matrix3d world_R_mj;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) world_R_mj(r, c) = d->cam_xmat[9 * cam_id + 3 * r + c];
+  // MuJoCo camera axes: x right, y up, looking along -z. OpenCV: x right, y
+  // down, z forward. So OpenCV = MuJoCo * diag(1, -1, -1).
+  world_T_camera.linear() = world_R_mj * Eigen::Vector3d(1, -1, -1).asDiagonal();
+  world_T_camera.translation() =
+      Eigen::Vector3d(d->cam_xpos[3 * cam_id], d->cam_xpos[3 * cam_id + 1],
+                      d->cam_xpos[3 * cam_id + 2]);
+  return world_T_camera;
+}
+
+Eigen::Quaterniond MujocoCameraQuat(const Eigen::Matrix3d& world_R_camera) {
+  const Eigen::Matrix3d world_R_mj = world_R_camera * Eigen::Vector3d(1, -1, -1).asDiagonal();
+  return Eigen::Quaterniond(world_R_mj).normalized();
+}
+
+}  // namespace sim

@@ -1,0 +1,105 @@
+// The MJCF model of the TAVT, generated from the configuration so that the
+// model and the kinematics the algorithms use can never disagree.
+#include <cmath>
+#include <sstream>
+
+#include "sim/simulation.h"
+
+namespace sim {
+
+void NoiseConfig::Check() const {
+  if (!(read_noise_sigma_dn >= 0)) throw SceneError("noise.read_noise_sigma_dn must be >= 0");
+  if (!(blur_sigma_px >= 0)) throw SceneError("noise.blur_sigma_px must be >= 0");
+}
+
+void SimRigConfig::Check() const {
+  auto fail = [](const std::string& what) { throw SceneError("rig config: " + what); };
+  if (width_px < 16 || height_px < 16 || width_px > 4096 || height_px > 4096)
+    fail("image size must be within 16 to 4096 pixels per side");
+  if (!(horizontal_fov_deg > 1 && horizontal_fov_deg < 120))
+    fail("horizontal_fov_deg must be in (1, 120)");
+  if (!optical_centre_offset_m.allFinite() || optical_centre_offset_m.norm() > 0.2)
+    fail("optical_centre_offset_m must be finite and under 0.2 m");
+  if (!(carriage_min_m >= 0 && carriage_max_m > carriage_min_m && carriage_max_m <= 2))
+    fail("carriage travel must satisfy 0 <= carriage_min_m < carriage_max_m <= 2");
+  if (!(home_baseline_m >= 2 * carriage_min_m && home_baseline_m <= 2 * carriage_max_m))
+    fail("home_baseline_m must lie within the carriages' travel");
+  if (!(pan_limit_deg > 0 && pan_limit_deg < 180)) fail("pan_limit_deg must be in (0, 180)");
+  if (!(tilt_limit_deg > 0 && tilt_limit_deg < 90)) fail("tilt_limit_deg must be in (0, 90)");
+  if (!(baseline_steps_per_mm > 0) || !(pan_tilt_steps_per_deg > 0))
+    fail("steps per unit must be positive");
+  if (!(settle_tolerance_steps >= 0.5)) fail("settle_tolerance_steps must be >= 0.5");
+  if (!(move_timeout_s > 0)) fail("move_timeout_s must be positive");
+  noise.Check();
+}
+
+std::string RigMjcf(const SimRigConfig& c) {
+  const double f_px = 0.5 * c.width_px / std::tan(0.5 * c.horizontal_fov_deg * M_PI / 180);
+  const double fovy_deg = 2 * std::atan(0.5 * c.height_px / f_px) * 180 / M_PI;
+  const Eigen::Vector3d& o = c.optical_centre_offset_m;
+  std::ostringstream x;
+  x.precision(12);
+  // Ranges and near/far planes are set on the compiled model (in SI units),
+  // so a scene's <compiler angle=...> cannot change them.
+  x << R"(<mujoco model="tavt">
+  <option timestep="0.001" gravity="0 0 0"/>
+  <visual>
+    <global offwidth=")" << c.width_px << R"(" offheight=")" << c.height_px << R"("/>
+    <quality offsamples="4"/>
+    <headlight ambient="0.25 0.25 0.25" diffuse="0 0 0" specular="0 0 0"/>
+  </visual>
+  <default>
+    <default class="tavt">
+      <geom group="4" contype="0" conaffinity="0" rgba="0.25 0.25 0.28 1"/>
+    </default>
+  </default>
+  <worldbody>
+    <camera name="tavt_truth" pos="0 0 0" xyaxes="1 0 0 0 0 1" fovy=")" << fovy_deg << R"("/>
+    <body name="tavt_rail" childclass="tavt">
+      <geom name="tavt_rail" type="box" size=")" << c.carriage_max_m + 0.05 << R"( 0.03 0.01" pos="0 0 -0.08"/>
+)";
+  for (const char* side : {"left", "right"}) {
+    // Carriage: slide along X. Head: pan about Z, tilt about the panned X.
+    // Inertias: carriage 2 kg plus 3 kg reflected screw inertia; pan and tilt
+    // heads with reflected rotor inertia (armature) dominating, as on
+    // geared microstepping stages. Damping makes each servo about critical.
+    x << R"(      <body name="tavt_)" << side << R"(_carriage" pos="0 0 0">
+        <inertial pos="0 0 0" mass="2" diaginertia="0.01 0.01 0.01"/>
+        <joint name="tavt_)" << side
+      << R"(_baseline" type="slide" axis="1 0 0" armature="3" damping="170"/>
+        <geom type="box" size="0.04 0.05 0.01" pos="0 0 -0.065"/>
+        <body name="tavt_)" << side << R"(_pan" pos="0 0 0">
+          <inertial pos="0 0 0" mass="0.5" diaginertia="0.002 0.002 0.002"/>
+          <joint name="tavt_)" << side
+      << R"(_pan" type="hinge" axis="0 0 1" armature="0.02" damping="1.2"/>
+          <geom type="cylinder" size="0.02 0.02" pos="0 0 -0.04"/>
+          <body name="tavt_)" << side << R"(_tilt" pos="0 0 0">
+            <inertial pos="0 0 0" mass="0.4" diaginertia="0.001 0.001 0.001"/>
+            <joint name="tavt_)" << side
+      << R"(_tilt" type="hinge" axis="1 0 0" armature="0.01" damping="0.62"/>
+            <geom type="box" size="0.02 0.035 0.02" pos=")" << o.x() << " " << o.y() - 0.035
+      << " " << o.z() << R"("/>
+            <camera name="tavt_)" << side << R"(" pos=")" << o.x() << " " << o.y() << " "
+      << o.z() << R"(" xyaxes="1 0 0 0 0 1" fovy=")" << fovy_deg << R"("/>
+          </body>
+        </body>
+      </body>
+)";
+  }
+  x << R"(    </body>
+  </worldbody>
+  <actuator>
+)";
+  for (const char* side : {"left", "right"}) {
+    x << "    <position name=\"tavt_" << side << "_baseline\" joint=\"tavt_" << side
+      << "_baseline\" kp=\"1500\" forcelimited=\"true\" forcerange=\"-40 40\"/>\n"
+      << "    <position name=\"tavt_" << side << "_pan\" joint=\"tavt_" << side
+      << "_pan\" kp=\"15\" forcelimited=\"true\" forcerange=\"-1.5 1.5\"/>\n"
+      << "    <position name=\"tavt_" << side << "_tilt\" joint=\"tavt_" << side
+      << "_tilt\" kp=\"8\" forcelimited=\"true\" forcerange=\"-0.8 0.8\"/>\n";
+  }
+  x << "  </actuator>\n</mujoco>\n";
+  return x.str();
+}
+
+}  // namespace sim

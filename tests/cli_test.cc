@@ -1,0 +1,88 @@
+// The fovea program as a user runs it: outputs, exit codes, one-line errors.
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <catch2/catch.hpp>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+  int exit_code;
+  std::string err;
+};
+
+// Runs `fovea ARGS`, capturing stderr.
+Result Fovea(const std::string& args) {
+  const fs::path err_file = fs::temp_directory_path() / ("fovea_cli_err_" + std::to_string(getpid()));
+  const std::string cmd = std::string(FOVEA_BIN) + " " + args + " >/dev/null 2>" + err_file.string();
+  const int status = std::system(cmd.c_str());
+  std::ifstream in(err_file);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  fs::remove(err_file);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : 128, ss.str()};
+}
+
+int Lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
+
+fs::path TempDir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("fovea_cli_" + name + "_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  return dir;
+}
+
+}  // namespace
+
+TEST_CASE("fovea render writes both images and the true depth", "[cli]") {
+  const fs::path out = TempDir("render");
+  const Result r = Fovea("render --state -0.06,1.5,0,0.06,-1.5,0 --out " + out.string());
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  for (const char* f : {"left.png", "right.png", "depth_left.png", "depth_right.png",
+                        "depth_left_mm.png", "depth_right_mm.png", "render.json"})
+    CHECK(fs::file_size(out / f) > 100);
+  // No temporary files left behind.
+  for (const auto& e : fs::directory_iterator(out))
+    CHECK(e.path().filename().string().find("partial") == std::string::npos);
+  fs::remove_all(out);
+}
+
+TEST_CASE("bad input gives one line on stderr, a non-zero exit and no output", "[cli]") {
+  const fs::path out = TempDir("bad");
+  const fs::path dir = TempDir("scenes");
+  fs::create_directories(dir);
+  std::ofstream(dir / "broken.xml") << "<mujoco><worldbody><geom type=\"box\"</worldbody>";
+  std::ofstream(dir / "norig.xml") << "<mujoco><worldbody><geom size=\"1\"/></worldbody></mujoco>";
+  std::ofstream(dir / "notxml.xml") << "hello";
+  struct Case {
+    std::string args, expect;
+  };
+  const std::vector<Case> cases = {
+      {"render --scene /nonexistent/scene.xml", "/nonexistent/scene.xml"},
+      {"render --scene no_such_scene", "unknown scene 'no_such_scene'"},
+      {"render --scene " + (dir / "broken.xml").string(), "broken.xml"},
+      {"render --scene " + (dir / "norig.xml").string(), "does not include the rig"},
+      {"render --scene " + (dir / "notxml.xml").string(), "not an MJCF"},
+      {"render --state 0,0,0,0.05,0,0", "left baseline"},
+      {"render --state -0.05,0,0,0.05,75,0", "right pan"},
+      {"render --state 1,2,3", "exactly 6"},
+      {"render --state -0.05,x,0,0.05,0,0", "'x' is not a number"},
+      {"render --baseline 2.0", "baseline"},
+  };
+  for (const Case& c : cases) {
+    const Result r = Fovea(c.args + " --out " + out.string());
+    INFO(c.args << " -> exit " << r.exit_code << ": " << r.err);
+    CHECK(r.exit_code != 0);
+    CHECK(r.exit_code < 128);  // an exit, not a signal
+    CHECK(Lines(r.err) == 1);
+    CHECK(r.err.find(c.expect) != std::string::npos);
+    CHECK_FALSE(fs::exists(out));
+  }
+  fs::remove_all(dir);
+}
