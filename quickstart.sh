@@ -39,6 +39,7 @@ case "${1:-}" in
     mkdir -p out
     ./build/experiments/fovea render --out out/render_home
     ./build/experiments/fovea render --state -0.08,-2.5,1,0.08,2.5,1 --out out/render_verged
+    ./build/experiments/fovea catalog --out out
     echo "quickstart: pictures and figures are in out/"
     ;;
   test)

@@ -8,6 +8,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "temp_scene.h"
+
 namespace fs = std::filesystem;
 
 namespace {
@@ -53,6 +55,23 @@ TEST_CASE("fovea render writes both images and the true depth", "[cli]") {
   fs::remove_all(out);
 }
 
+TEST_CASE("a user scene in any folder renders through the CLI", "[cli]") {
+  // Written as scenes/README.md says: include the rig, generated textures.
+  const TempScene scene(
+      "<geom name=\"board\" type=\"box\" size=\"0.5 0.4 0.005\" pos=\"0 0.905 0\" "
+      "zaxis=\"0 -1 0\" material=\"bark\"/><geom name=\"can\" type=\"mesh\" mesh=\"can\" "
+      "pos=\"0.05 0.7 0\" material=\"bark\"/>",
+      "<texture name=\"bark\" type=\"2d\" file=\"wood-s7.png\"/><mesh name=\"can\" "
+      "file=\"cylinder-r60-h300.obj\"/><material name=\"bark\" texture=\"bark\" "
+      "texrepeat=\"4 4\" texuniform=\"true\" specular=\"0\"/>");
+  const fs::path out = TempDir("user");
+  const Result r = Fovea("render --scene " + scene.path() + " --out " + out.string());
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(fs::file_size(out / "left.png") > 10000);
+  fs::remove_all(out);
+}
+
 TEST_CASE("bad input gives one line on stderr, a non-zero exit and no output", "[cli]") {
   const fs::path out = TempDir("bad");
   const fs::path dir = TempDir("scenes");
@@ -60,6 +79,9 @@ TEST_CASE("bad input gives one line on stderr, a non-zero exit and no output", "
   std::ofstream(dir / "broken.xml") << "<mujoco><worldbody><geom type=\"box\"</worldbody>";
   std::ofstream(dir / "norig.xml") << "<mujoco><worldbody><geom size=\"1\"/></worldbody></mujoco>";
   std::ofstream(dir / "notxml.xml") << "hello";
+  const TempScene intruder("<geom type=\"box\" size=\"0.05 0.05 0.05\" pos=\"0 0.1 0\"/>");
+  const TempScene driver("<geom type=\"box\" size=\"0.5 0.5 0.01\" pos=\"0 1 0\"/>", "",
+                         "<actuator><motor joint=\"tavt_right_tilt\"/></actuator>");
   struct Case {
     std::string args, expect;
   };
@@ -74,6 +96,9 @@ TEST_CASE("bad input gives one line on stderr, a non-zero exit and no output", "
       {"render --state 1,2,3", "exactly 6"},
       {"render --state -0.05,x,0,0.05,0,0", "'x' is not a number"},
       {"render --baseline 2.0", "baseline"},
+      {"render --scene " + intruder.path(), "rig's workspace"},
+      {"render --scene " + driver.path(), "may not move the rig"},
+      {"render --scene random:1:99", "N must be 1 to 30"},
   };
   for (const Case& c : cases) {
     const Result r = Fovea(c.args + " --out " + out.string());

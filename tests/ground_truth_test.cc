@@ -2,17 +2,26 @@
 #include <cmath>
 
 #include "scenes/catalog.h"
+#include "temp_scene.h"
+
+namespace {
+// A fronto-parallel plane whose face is 1.0 m from the rail.
+const TempScene& PlaneScene() {
+  static const TempScene scene(TempScene::PlaneAt(1.0), TempScene::PhotoAsset());
+  return scene;
+}
+}  // namespace
 
 TEST_CASE("rendered depth agrees with exact ray casting on a fronto-parallel plane", "[sim]") {
-  auto sim = scenes::LoadScene("plane", sim::SimRigConfig{});
+  auto sim = scenes::LoadScene(PlaneScene().path(), sim::SimRigConfig{});
   const rig::StereoFrame frame = sim->rig().Capture();
   const rig::CameraView& view = frame.left;
   const cv::Mat rendered = sim->truth().Render(view.world_T_camera, view.intrinsics).depth_m;
   cv::Mat ids;
   const cv::Mat cast = sim->truth().RayCastDepth(view.world_T_camera, view.intrinsics, &ids);
-  // The plane's front face is at y = 0.995; the level camera's centre at y = 0.03.
-  const double expected = 0.995 - view.world_T_camera.translation().y();
-  REQUIRE(expected == Approx(0.965));
+  // The plane's front face is at y = 1.0; the level camera's centre at y = 0.03.
+  const double expected = 1.0 - view.world_T_camera.translation().y();
+  REQUIRE(expected == Approx(0.97));
   double worst_render = 0, worst_cast = 0;
   for (int v = 0; v < rendered.rows; ++v)
     for (int u = 0; u < rendered.cols; ++u) {
@@ -25,21 +34,21 @@ TEST_CASE("rendered depth agrees with exact ray casting on a fronto-parallel pla
 }
 
 TEST_CASE("ray casts hit scene geoms only and report distance and point", "[sim]") {
-  auto sim = scenes::LoadScene("plane", sim::SimRigConfig{});
+  auto sim = scenes::LoadScene(PlaneScene().path(), sim::SimRigConfig{});
   const Eigen::Vector3d origin(0.1, 0.0, 0.05);
   const auto hit = sim->truth().CastRay(origin, Eigen::Vector3d(0, 2, 0));
   REQUIRE(hit);
-  CHECK(hit->distance_m == Approx(0.995).margin(1e-9));
-  CHECK((hit->point_W - Eigen::Vector3d(0.1, 0.995, 0.05)).norm() < 1e-9);
+  CHECK(hit->distance_m == Approx(1.0).margin(1e-9));
+  CHECK((hit->point_W - Eigen::Vector3d(0.1, 1.0, 0.05)).norm() < 1e-9);
   CHECK_FALSE(sim->truth().CastRay(origin, Eigen::Vector3d(0, -1, 0)));
   // A slanted ray: range grows as 1 / cos.
   const auto slanted = sim->truth().CastRay(origin, Eigen::Vector3d(std::tan(0.2), 1, 0));
   REQUIRE(slanted);
-  CHECK(slanted->distance_m == Approx(0.995 / std::cos(0.2)).margin(1e-9));
+  CHECK(slanted->distance_m == Approx(1.0 / std::cos(0.2)).margin(1e-9));
 }
 
 TEST_CASE("ray-cast depth works for any intrinsics, rendering refuses what it cannot draw", "[sim]") {
-  auto sim = scenes::LoadScene("plane", sim::SimRigConfig{});
+  auto sim = scenes::LoadScene(PlaneScene().path(), sim::SimRigConfig{});
   const rig::CameraView view = sim->rig().Capture().left;
   rig::CameraIntrinsics k = view.intrinsics;
   k.width_px = 64;
@@ -47,6 +56,6 @@ TEST_CASE("ray-cast depth works for any intrinsics, rendering refuses what it ca
   k.cx_px = 20;
   k.distortion = {-0.1, 0.01, 0, 0};
   const cv::Mat cast = sim->truth().RayCastDepth(view.world_T_camera, k);
-  CHECK(cast.at<float>(10, 10) == Approx(0.965).margin(1e-5));
+  CHECK(cast.at<float>(10, 10) == Approx(0.97).margin(1e-5));
   CHECK_THROWS_AS(sim->truth().Render(view.world_T_camera, k), rig::RigError);
 }

@@ -12,6 +12,7 @@
 #include "rig/kinematics.h"
 #include "scenes/catalog.h"
 #include "sim/sim_rig.h"
+#include "temp_scene.h"
 
 namespace {
 
@@ -54,10 +55,16 @@ Eigen::Vector2d BlobCentroid(const cv::Mat& gray, const Eigen::Vector2d& guess) 
   return {su / sw, sv / sw};
 }
 
+// A fronto-parallel plane whose face is 1.0 m from the rail.
+const TempScene& PlaneScene() {
+  static const TempScene scene(TempScene::PlaneAt(1.0), TempScene::PhotoAsset());
+  return scene;
+}
+
 }  // namespace
 
 TEST_CASE("camera poses from MuJoCo match the rig's forward kinematics", "[sim]") {
-  auto sim = scenes::LoadScene("plane", sim::SimRigConfig{});
+  auto sim = scenes::LoadScene(PlaneScene().path(), sim::SimRigConfig{});
   rig::Rig& rig = sim->rig();
   for (const auto& target :
        {rig.Home(), rig::StageState::FromArray({-0.2, 10 * kDeg, -5 * kDeg, 0.15, -20 * kDeg, 8 * kDeg}),
@@ -75,7 +82,7 @@ TEST_CASE("camera poses from MuJoCo match the rig's forward kinematics", "[sim]"
 }
 
 TEST_CASE("moves are quantized to whole steps, settle, and take physical time", "[sim]") {
-  auto sim = scenes::LoadScene("plane", sim::SimRigConfig{});
+  auto sim = scenes::LoadScene(PlaneScene().path(), sim::SimRigConfig{});
   rig::Rig& rig = sim->rig();
   const rig::RigLimits& limits = rig.Limits();
   const double pan_step = 1 / limits[rig::Axis::kLeftPan].steps_per_unit;
@@ -103,7 +110,7 @@ TEST_CASE("moves are quantized to whole steps, settle, and take physical time", 
 }
 
 TEST_CASE("a move outside the axis limits is refused before anything moves", "[sim]") {
-  auto sim = scenes::LoadScene("plane", sim::SimRigConfig{});
+  auto sim = scenes::LoadScene(PlaneScene().path(), sim::SimRigConfig{});
   rig::Rig& rig = sim->rig();
   const rig::StageState before = rig.State();
   rig::StageState bad = rig.Home();
@@ -151,7 +158,7 @@ TEST_CASE("a known 3D point renders where the camera model projects it", "[sim]"
 }
 
 TEST_CASE("the rig's own geometry never appears in its images", "[sim]") {
-  auto sim = scenes::LoadScene("plane", sim::SimRigConfig{});
+  auto sim = scenes::LoadScene(PlaneScene().path(), sim::SimRigConfig{});
   // A virtual camera behind the rig, looking through both heads at the plane.
   rig::Rig& rig = sim->rig();
   const Eigen::Isometry3d left = rig.Capture().left.world_T_camera;
@@ -161,18 +168,18 @@ TEST_CASE("the rig's own geometry never appears in its images", "[sim]") {
   const cv::Mat depth = sim->truth().Render(behind, k).depth_m;
   double min_depth = 0;
   cv::minMaxLoc(depth, &min_depth, nullptr);
-  // Nearest visible surface is the plane (front face 1.395 m away), not a head.
-  CHECK(min_depth == Approx(1.395).margin(0.002));
+  // Nearest visible surface is the plane (front face 1.4 m away), not a head.
+  CHECK(min_depth == Approx(1.4).margin(0.002));
 }
 
 TEST_CASE("identical seed and pose give identical images, and noise has its sigma", "[sim]") {
   sim::SimRigConfig config;
   config.noise.read_noise_sigma_dn = 4.0;
   config.seed = 42;
-  auto a = scenes::LoadScene("plane", config);
-  auto b = scenes::LoadScene("plane", config);
+  auto a = scenes::LoadScene(PlaneScene().path(), config);
+  auto b = scenes::LoadScene(PlaneScene().path(), config);
   config.seed = 43;
-  auto c = scenes::LoadScene("plane", config);
+  auto c = scenes::LoadScene(PlaneScene().path(), config);
   const auto target = rig::StageState::FromArray({-0.07, 2 * kDeg, 1 * kDeg, 0.05, -1 * kDeg, 0});
   a->rig().MoveTo(target);
   b->rig().MoveTo(target);
@@ -183,7 +190,7 @@ TEST_CASE("identical seed and pose give identical images, and noise has its sigm
   CHECK(cv::norm(fa.left.gray, fc.left.gray, cv::NORM_INF) > 0);
 
   sim::SimRigConfig clean_config;
-  auto clean = scenes::LoadScene("plane", clean_config);
+  auto clean = scenes::LoadScene(PlaneScene().path(), clean_config);
   clean->rig().MoveTo(target);
   const cv::Mat truth = clean->rig().Capture().left.gray;
   cv::Mat diff;

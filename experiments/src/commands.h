@@ -10,5 +10,6 @@ namespace experiments {
 /// perform when that subcommand is chosen.
 void AddRenderCommand(CLI::App& app, std::function<int()>* run);
 void AddBenchCommand(CLI::App& app, std::function<int()>* run);
+void AddCatalogCommands(CLI::App& app, std::function<int()>* run);
 
 }  // namespace experiments

@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
   std::function<int()> run;
   experiments::AddRenderCommand(app, &run);
   experiments::AddBenchCommand(app, &run);
+  experiments::AddCatalogCommands(app, &run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

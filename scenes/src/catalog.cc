@@ -4,11 +4,15 @@
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 
+#include "scenes/generated.h"
 #include "scenes/textures.h"
 
 namespace scenes {
 
-std::vector<std::string> CatalogNames() { return {"plane"}; }
+std::vector<std::string> CatalogNames() {
+  return {"fronto_planes", "cylinder_planes", "two_planes", "three_surfaces",
+          "periodic",      "textureless",     "random"};
+}
 
 std::string ScenesDir() {
   if (const char* env = std::getenv("FOVEA_SCENES_DIR"); env && *env) return env;
@@ -20,6 +24,7 @@ std::string ResolveScene(const std::string& name_or_path) {
       std::filesystem::path(name_or_path).extension() == ".xml") {
     return name_or_path;
   }
+  if (ParseRandomSceneName(name_or_path)) return name_or_path;
   for (const auto& name : CatalogNames())
     if (name == name_or_path) return ScenesDir() + "/" + name + ".xml";
   std::string names;
@@ -30,6 +35,7 @@ std::string ResolveScene(const std::string& name_or_path) {
 
 sim::AssetProvider TextureProvider() {
   return [](const std::string& name) -> std::optional<std::vector<uint8_t>> {
+    if (auto mesh = MakeMesh(name)) return std::vector<uint8_t>(mesh->begin(), mesh->end());
     const auto parsed = ParseTextureName(name);
     if (!parsed) return std::nullopt;
     const auto kinds = TextureKinds();
@@ -43,7 +49,10 @@ sim::AssetProvider TextureProvider() {
 
 std::unique_ptr<sim::Simulation> LoadScene(const std::string& name_or_path,
                                            const sim::SimRigConfig& config) {
-  return sim::Simulation::Load(ResolveScene(name_or_path), config, TextureProvider());
+  const std::string resolved = ResolveScene(name_or_path);
+  if (auto spec = ParseRandomSceneName(resolved))
+    return sim::Simulation::LoadText(resolved, RandomSceneXml(*spec), config, TextureProvider());
+  return sim::Simulation::Load(resolved, config, TextureProvider());
 }
 
 }  // namespace scenes

@@ -77,4 +77,22 @@ std::string GroundTruth::GeomName(int geom_id) const {
   return name ? name : "geom" + std::to_string(geom_id);
 }
 
+bool GroundTruth::Textured(int geom_id) const {
+  const mjModel* m = world_->m;
+  if (geom_id < 0 || geom_id >= m->ngeom) return false;
+  if (textured_.empty()) {
+    textured_.resize(m->ngeom);
+    for (int g = 0; g < m->ngeom; ++g) textured_[g] = GeomTextured(m, g) ? 1 : 0;
+  }
+  return textured_[geom_id] != 0;
+}
+
+cv::Mat GroundTruth::TexturedMask(const cv::Mat& geom_ids) const {
+  cv::Mat mask(geom_ids.size(), CV_8UC1);
+  for (int r = 0; r < geom_ids.rows; ++r)
+    for (int c = 0; c < geom_ids.cols; ++c)
+      mask.at<uchar>(r, c) = Textured(geom_ids.at<int>(r, c)) ? 255 : 0;
+  return mask;
+}
+
 }  // namespace sim

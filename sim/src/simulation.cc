@@ -55,16 +55,28 @@ std::unique_ptr<Simulation> Simulation::Load(const std::string& scene_path,
                                              const SimRigConfig& config,
                                              const AssetProvider& assets) {
   config.Check();
-  mju_user_error = MujocoError;
-  mju_user_warning = MujocoWarning;
-
   std::ifstream in(scene_path, std::ios::binary);
   if (!in) {
     throw SceneError("cannot read scene file '" + scene_path + "': " + std::strerror(errno));
   }
   std::stringstream text;
   text << in.rdbuf();
-  const std::string xml = text.str();
+  return LoadImpl(scene_path, text.str(), /*from_memory=*/false, config, assets);
+}
+
+std::unique_ptr<Simulation> Simulation::LoadText(const std::string& name, const std::string& xml,
+                                                 const SimRigConfig& config,
+                                                 const AssetProvider& assets) {
+  config.Check();
+  return LoadImpl(name, xml, /*from_memory=*/true, config, assets);
+}
+
+std::unique_ptr<Simulation> Simulation::LoadImpl(const std::string& scene_path,
+                                                 const std::string& xml, bool from_memory,
+                                                 const SimRigConfig& config,
+                                                 const AssetProvider& assets) {
+  mju_user_error = MujocoError;
+  mju_user_warning = MujocoWarning;
   if (xml.find("<mujoco") == std::string::npos)
     throw SceneError("scene file '" + scene_path + "' is not an MJCF model (no <mujoco> element)");
 
@@ -83,8 +95,10 @@ std::unique_ptr<Simulation> Simulation::Load(const std::string& scene_path,
       if (auto bytes = assets(name)) AddToVfs(vfs.get(), name, bytes->data(), bytes->size());
     }
   }
+  const std::string main_name = from_memory ? "fovea_generated_scene.xml" : scene_path;
+  if (from_memory) AddToVfs(vfs.get(), main_name, xml.data(), xml.size());
   char error[1024] = "";
-  mjModel* m = mj_loadXML(scene_path.c_str(), vfs.get(), error, sizeof error);
+  mjModel* m = mj_loadXML(main_name.c_str(), vfs.get(), error, sizeof error);
   mj_deleteVFS(vfs.get());
   if (!m) throw SceneError("cannot load scene '" + scene_path + "': " + OneLine(error));
 
@@ -108,6 +122,8 @@ std::unique_ptr<Simulation> Simulation::Load(const std::string& scene_path,
   m->vis.map.zfar = static_cast<float>(30.0 / m->stat.extent);
   w.visible_groups = {1, 1, 1, 0, 0, 0};
   w.d = mj_makeData(m);
+  mj_forward(m, w.d);
+  CheckSceneRules(w, RigWorkspace(config));
   w.renderer = new OffscreenRenderer(m, config.width_px, config.height_px);
 
   sim->rig_ = std::make_unique<SimRig>(sim->world_.get(), config);

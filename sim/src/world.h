@@ -62,3 +62,14 @@ Eigen::Isometry3d CameraPoseFromMujoco(const mjData* d, int cam_id);
 Eigen::Quaterniond MujocoCameraQuat(const Eigen::Matrix3d& world_R_camera);
 
 }  // namespace sim
+
+namespace sim {
+struct Box3;
+/// Enforces the scene rules (scenes/README.md): the scene must not attach
+/// anything to the rig, drive its joints (actuators, tendons, equality
+/// constraints), or put geometry inside the rig's workspace `keep_out`.
+/// Throws SceneError naming the scene, the offending element and the rule.
+void CheckSceneRules(const World& world, const Box3& keep_out);
+/// True if the geom's material carries a texture with visible contrast.
+bool GeomTextured(const mjModel* m, int geom_id);
+}  // namespace sim

@@ -10,7 +10,7 @@
 namespace scenes {
 
 /// The scene every command uses when none is given.
-inline constexpr const char* kDefaultScene = "plane";
+inline constexpr const char* kDefaultScene = "cylinder_planes";
 
 /// Names of the catalog scenes.
 std::vector<std::string> CatalogNames();
@@ -19,12 +19,13 @@ std::vector<std::string> CatalogNames();
 /// the source tree's scenes/ folder.
 std::string ScenesDir();
 
-/// A catalog name ("plane") or a path to an MJCF file ("my/scene.xml"). A
-/// name that is not in the catalog throws sim::SceneError listing the names.
+/// A catalog name ("two_planes"), a random-scene name ("random:7:10", kept
+/// as is) or a path to an MJCF file ("my/scene.xml", kept as is). A name that
+/// is not in the catalog throws sim::SceneError listing the names.
 std::string ResolveScene(const std::string& name_or_path);
 
-/// Serves procedural textures to MuJoCo by file name (see scenes/README.md):
-/// "<kind>-s<seed>.png", generated deterministically in memory.
+/// Serves generated assets to MuJoCo by file name (see scenes/README.md):
+/// textures "<kind>-s<seed>.png" and meshes "cylinder-r<mm>-h<mm>.obj".
 sim::AssetProvider TextureProvider();
 
 /// Loads a scene by name or path with the procedural textures available.

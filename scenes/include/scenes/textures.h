@@ -1,4 +1,11 @@
 // Procedural, deterministic textures (OpenCV). Same kind and seed, same bytes.
+//
+// Scale: catalog materials tile a texture every 0.5 m (texrepeat="4 4"
+// texuniform="true": MuJoCo 2.2 tiles texrepeat / 2 times per metre, measured
+// by tests/catalog_test.cc), so one texel of a 1024-texel texture is 0.49 mm: the
+// pixel footprint of the default camera (f = 1194 px) is 0.33 mm at 0.4 m and
+// 1.26 mm at 1.5 m, so every textured kind has detail at the pixel scale over
+// the paper's working range.
 #pragma once
 
 #include <cstdint>
@@ -9,14 +16,19 @@
 
 namespace scenes {
 
-/// The texture kinds a scene may name.
+/// Texture side in texels, and the strict period of the periodic kinds.
+inline constexpr int kTextureSizePx = 1024;
+inline constexpr int kPeriodicPeriodPx = 32;  ///< 15.6 mm on a 0.5 m tile
+
+/// The texture kinds a scene may name: wood, tile, fabric, plywood, photo,
+/// stripes, checker (textured) and uniform (no texture at all).
 std::vector<std::string> TextureKinds();
 
-/// A square BGR texture of `kind`, `size_px` on a side, from `seed`. Throws
-/// sim::SceneError for an unknown kind.
-cv::Mat MakeTexture(const std::string& kind, uint64_t seed, int size_px = 1024);
+/// A square BGR texture of `kind` from `seed`. Throws sim::SceneError for an
+/// unknown kind.
+cv::Mat MakeTexture(const std::string& kind, uint64_t seed, int size_px = kTextureSizePx);
 
-/// Parses "<kind>-s<seed>.png"; nullopt if the name does not follow it.
+/// "<kind>-s<seed>.png" parsed; nullopt if the name does not follow it.
 struct TextureName {
   std::string kind;
   uint64_t seed = 0;

@@ -6,6 +6,7 @@
 #include <opencv2/core.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "rig/types.h"
 
@@ -51,8 +52,17 @@ class GroundTruth {
   /// The geom's name, or "geom<N>" for an unnamed one.
   std::string GeomName(int geom_id) const;
 
+  /// Whether a geom shows texture (its material's texture has visible
+  /// contrast); false for plain colours and the uniform texture, and for -1.
+  bool Textured(int geom_id) const;
+
+  /// CV_8UC1 mask, 255 where `geom_ids` (from RayCastDepth) shows a textured
+  /// surface.
+  cv::Mat TexturedMask(const cv::Mat& geom_ids) const;
+
  private:
   World* world_;
+  mutable std::vector<signed char> textured_;  // per geom, computed on first use
 };
 
 }  // namespace sim

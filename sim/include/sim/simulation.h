@@ -26,6 +26,14 @@ inline constexpr const char* kRigIncludeName = "tavt.xml";
 /// MJCF text of the TAVT for a configuration (what a scene's include reads).
 std::string RigMjcf(const SimRigConfig& config);
 
+/// The box, in the world, that scene geometry must keep out of: the rig's
+/// rail, carriages and heads over their whole travel (scene rule 3, see
+/// scenes/README.md).
+struct Box3 {
+  Eigen::Vector3d min_W, max_W;
+};
+Box3 RigWorkspace(const SimRigConfig& config);
+
 class SimRig;
 
 class Simulation {
@@ -36,6 +44,13 @@ class Simulation {
   static std::unique_ptr<Simulation> Load(const std::string& scene_path,
                                           const SimRigConfig& config,
                                           const AssetProvider& assets = {});
+
+  /// Same, for a scene given as MJCF text (a generated scene); `name` stands
+  /// for its path in messages. Relative asset paths resolve from the working
+  /// folder.
+  static std::unique_ptr<Simulation> LoadText(const std::string& name, const std::string& xml,
+                                              const SimRigConfig& config,
+                                              const AssetProvider& assets = {});
   ~Simulation();
   Simulation(const Simulation&) = delete;
   Simulation& operator=(const Simulation&) = delete;
@@ -47,6 +62,9 @@ class Simulation {
 
  private:
   Simulation();
+  static std::unique_ptr<Simulation> LoadImpl(const std::string& name, const std::string& xml,
+                                              bool from_memory, const SimRigConfig& config,
+                                              const AssetProvider& assets);
   std::unique_ptr<World> world_;
   std::unique_ptr<SimRig> rig_;
   std::unique_ptr<GroundTruth> truth_;
