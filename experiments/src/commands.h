@@ -11,5 +11,6 @@ namespace experiments {
 void AddRenderCommand(CLI::App& app, std::function<int()>* run);
 void AddBenchCommand(CLI::App& app, std::function<int()>* run);
 void AddCatalogCommands(CLI::App& app, std::function<int()>* run);
+void AddIdrCommand(CLI::App& app, std::function<int()>* run);
 
 }  // namespace experiments

@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   experiments::AddRenderCommand(app, &run);
   experiments::AddBenchCommand(app, &run);
   experiments::AddCatalogCommands(app, &run);
+  experiments::AddIdrCommand(app, &run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -1,0 +1,401 @@
+#include "fovea/idr.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <unordered_map>
+
+namespace fovea {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double Since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+double AngleDiff(double a, double b) {
+  double d = std::fmod(std::abs(a - b), 2 * M_PI);
+  return d > M_PI ? 2 * M_PI - d : d;
+}
+
+bool Compatible(const ZeroCrossing& a, const ZeroCrossing& b, const ZcMatchOptions& o) {
+  return a.polarity == b.polarity && AngleDiff(a.orientation_rad, b.orientation_rad) <= o.orientation_tolerance_rad;
+}
+
+// Unique compatible crossing of `other` on row y with position in
+// [x_lo, x_hi]; -1 none, -2 several. With take_nearest_when_ambiguous,
+// several yield the smallest-disparity one, encoded as -3 - index.
+int FindUnique(const ZeroCrossing& zc, const ZeroCrossingImage& other, double x_lo, double x_hi,
+               const ZcMatchOptions& o, bool smallest_disparity_is_high_x) {
+  const int b = other.row_begin[zc.y_px], e = other.row_begin[zc.y_px + 1];
+  const auto first = std::lower_bound(other.crossings.begin() + b, other.crossings.begin() + e, x_lo,
+                                      [](const ZeroCrossing& c, double x) { return c.x_px < x; });
+  int found = -1, count = 0, nearest = -1;
+  for (auto it = first; it != other.crossings.begin() + e && it->x_px <= x_hi; ++it) {
+    if (!Compatible(zc, *it, o)) continue;
+    const int index = static_cast<int>(it - other.crossings.begin());
+    if (++count == 1) found = index;
+    // Scanning by increasing x: the last is the highest x.
+    if (nearest < 0 || smallest_disparity_is_high_x) nearest = index;
+  }
+  if (count <= 1) return found;
+  return o.take_nearest_when_ambiguous ? -3 - nearest : -2;
+}
+
+double Quantile(std::vector<double> v, double q) {
+  if (v.empty()) return 0;
+  const size_t k = std::min(v.size() - 1, static_cast<size_t>(q * (v.size() - 1) + 0.5));
+  std::nth_element(v.begin(), v.begin() + k, v.end());
+  return v[k];
+}
+
+}  // namespace
+
+double ZcMatchStats::UnambiguousShare() const {
+  const int with_candidates = unique + ambiguous;
+  return with_candidates > 0 ? static_cast<double>(unique) / with_candidates : 0.0;
+}
+
+bool DisparityWindows::Window(double x_px, int y_px, double* lo, double* hi) const {
+  if (global) {
+    *lo = global_lo_px;
+    *hi = global_hi_px;
+    return true;
+  }
+  bool any = false;
+  for (int y = std::max(0, y_px - row_reach); y <= std::min<int>(rows.size() - 1, y_px + row_reach); ++y) {
+    const auto& row = rows[y];
+    auto it = std::lower_bound(row.begin(), row.end(), static_cast<float>(x_px - reach_px),
+                               [](const Anchor& a, float x) { return a.x_px < x; });
+    for (; it != row.end() && it->x_px <= x_px + reach_px; ++it) {
+      if (!any) {
+        *lo = it->lo_px;
+        *hi = it->hi_px;
+        any = true;
+      } else {
+        *lo = std::min<double>(*lo, it->lo_px);
+        *hi = std::max<double>(*hi, it->hi_px);
+      }
+    }
+  }
+  return any;
+}
+
+std::vector<ZcMatch> MatchZeroCrossings(const ZeroCrossingImage& left, const ZeroCrossingImage& right,
+                                        const DisparityWindows& left_windows,
+                                        const DisparityWindows& right_windows,
+                                        const ZcMatchOptions& options, ZcMatchStats* stats) {
+  ZcMatchStats s;
+  s.left_crossings = static_cast<int>(left.crossings.size());
+  s.right_crossings = static_cast<int>(right.crossings.size());
+  // Right to left first: for right crossing j, its unique left partner.
+  std::vector<int> right_partner(right.crossings.size(), -1);
+  for (size_t j = 0; j < right.crossings.size(); ++j) {
+    const ZeroCrossing& zc = right.crossings[j];
+    double lo, hi;
+    if (!right_windows.Window(zc.x_px, zc.y_px, &lo, &hi)) continue;
+    // d = x_left - x_right: the smallest disparity is the lowest left x.
+    int found = FindUnique(zc, left, zc.x_px + lo, zc.x_px + hi, options, false);
+    if (found <= -3) found = -3 - found;
+    right_partner[j] = found;
+  }
+  std::vector<ZcMatch> matches;
+  for (size_t i = 0; i < left.crossings.size(); ++i) {
+    const ZeroCrossing& zc = left.crossings[i];
+    double lo, hi;
+    if (!left_windows.Window(zc.x_px, zc.y_px, &lo, &hi)) continue;
+    ++s.searched;
+    // Disparity d = x_left - x_right, so x_right in [x - hi, x - lo].
+    int j = FindUnique(zc, right, zc.x_px - hi, zc.x_px - lo, options, true);
+    if (j == -1) {
+      ++s.no_candidate;
+      continue;
+    }
+    if (j == -2) {
+      ++s.ambiguous;
+      continue;
+    }
+    if (j <= -3) {
+      ++s.ambiguous;  // resolved by the nearest-candidate policy
+      j = -3 - j;
+    } else {
+      ++s.unique;
+    }
+    if (right_partner[j] != static_cast<int>(i)) {
+      ++s.inconsistent;
+      continue;
+    }
+    matches.push_back({static_cast<int>(i), j, zc.x_px - right.crossings[j].x_px});
+  }
+  s.matches = static_cast<int>(matches.size());
+  if (stats) *stats = s;
+  return matches;
+}
+
+std::vector<char> NearDiscontinuity(const std::vector<DisparitySample>& samples, double radius_px,
+                                    double jump_px) {
+  std::vector<char> flags(samples.size(), 0);
+  if (samples.empty()) return flags;
+  // Bucket by cells of radius_px; compare with the 3 x 3 neighbouring cells.
+  const double cell = std::max(1.0, radius_px);
+  std::unordered_map<long long, std::vector<int>> grid;
+  auto key = [&](double x, double y) {
+    return (static_cast<long long>(std::floor(y / cell)) << 32) ^ static_cast<long long>(std::floor(x / cell) + (1 << 30));
+  };
+  for (size_t i = 0; i < samples.size(); ++i) grid[key(samples[i].x_px, samples[i].y_px)].push_back(static_cast<int>(i));
+  // Along each row, consecutive samples (whatever their distance) that jump
+  // bracket a discontinuity.
+  std::unordered_map<int, std::vector<int>> rows;
+  for (size_t i = 0; i < samples.size(); ++i) rows[static_cast<int>(samples[i].y_px)].push_back(static_cast<int>(i));
+  for (auto& [y, idx] : rows) {
+    std::sort(idx.begin(), idx.end(), [&](int a, int b) { return samples[a].x_px < samples[b].x_px; });
+    for (size_t k = 1; k < idx.size(); ++k)
+      if (std::abs(samples[idx[k]].disparity_px - samples[idx[k - 1]].disparity_px) > jump_px)
+        flags[idx[k]] = flags[idx[k - 1]] = 1;
+  }
+  const double r2 = radius_px * radius_px;
+  for (size_t i = 0; i < samples.size(); ++i) {
+    const DisparitySample& a = samples[i];
+    for (int dy = -1; dy <= 1 && !flags[i]; ++dy)
+      for (int dx = -1; dx <= 1 && !flags[i]; ++dx) {
+        const auto it = grid.find(key(a.x_px + dx * cell, a.y_px + dy * cell));
+        if (it == grid.end()) continue;
+        for (int j : it->second) {
+          const DisparitySample& b = samples[j];
+          const double ddx = a.x_px - b.x_px, ddy = a.y_px - b.y_px;
+          if (ddx * ddx + ddy * ddy <= r2 && std::abs(a.disparity_px - b.disparity_px) > jump_px) {
+            flags[i] = 1;
+            break;
+          }
+        }
+      }
+  }
+  return flags;
+}
+
+double ExpansionFactor(double s_min_px, double d_max_px, double focal_px, double max_slant_rad) {
+  const double g = d_max_px * s_min_px * std::tan(max_slant_rad) / focal_px;
+  return s_min_px / (1 + g);
+}
+
+void IdrOptions::Check() const {
+  zero_crossings.Check();
+  auto fail = [](const std::string& m) { throw std::invalid_argument("idr: " + m); };
+  if (!(unique_share > 0 && unique_share < 1)) fail("unique_share must be in (0, 1)");
+  if (!(z_min_m > 0)) fail("z_min_m must be positive");
+  if (!(max_slant_deg >= 0 && max_slant_deg < 89)) fail("max_slant_deg must be in [0, 89)");
+  if (!(min_expansion > 1 && max_expansion >= min_expansion)) fail("need 1 < min_expansion <= max_expansion");
+  if (!(vergent_search_px > 0)) fail("vergent_search_px must be positive");
+  if (!(vergent_baseline_m > 0)) fail("vergent_baseline_m must be positive");
+  if (max_stages < 1 || max_stages > 20) fail("max_stages must be 1 to 20");
+  if (patch_size_px < 4 || patch_size_px > 256) fail("patch_size_px must be 4 to 256");
+  if (plane_fit.min_support < 3) fail("plane_fit.min_support must be >= 3");
+  if (!(plane_fit.fit_tolerance_px > 0)) fail("plane_fit.fit_tolerance_px must be positive");
+  if (!(fixed_initial_baseline_m >= 0)) fail("fixed_initial_baseline_m must be >= 0");
+}
+
+PatchMap PatchesFromDisparities(const std::vector<DisparitySample>& samples,
+                                const rig::CameraView& left, double baseline_m,
+                                int patch_size_px, const PlaneFitOptions& options,
+                                PatchLevel level) {
+  PatchMap map;
+  const rig::CameraIntrinsics& k = left.intrinsics;
+  // Bucket samples by block so each fit sees only its own.
+  const int bw = (k.width_px + patch_size_px - 1) / patch_size_px;
+  const int bh = (k.height_px + patch_size_px - 1) / patch_size_px;
+  std::vector<std::vector<DisparitySample>> blocks(bw * bh);
+  for (const auto& s : samples) {
+    const int bx = static_cast<int>(s.x_px) / patch_size_px, by = static_cast<int>(s.y_px) / patch_size_px;
+    if (bx >= 0 && bx < bw && by >= 0 && by < bh) blocks[by * bw + bx].push_back(s);
+  }
+  for (int by = 0; by < bh; ++by) {
+    for (int bx = 0; bx < bw; ++bx) {
+      const double x0 = bx * patch_size_px, y0 = by * patch_size_px;
+      Eigen::Vector4d box;
+      const auto fit = FitDisparityPlane(blocks[by * bw + bx], x0, y0, patch_size_px, options, &box);
+      if (!fit) continue;
+      // The block, cut back to half a pixel beyond its inliers: inside
+      // texture the inliers span the block (crossings on every row); at a
+      // depth step the last crossings stop short of the edge, and the patch
+      // must not reach over it.
+      const double ex0 = std::max(x0 - 0.5, box(0) - 0.5), ey0 = std::max(y0 - 0.5, box(1) - 0.5);
+      const double ex1 = std::min(x0 + patch_size_px - 0.5, box(2) + 0.5);
+      const double ey1 = std::min(y0 + patch_size_px - 0.5, box(3) + 0.5);
+      if (ex1 - ex0 < 2 || ey1 - ey0 < 2) continue;
+      Patch p;
+      p.level = level;
+      p.fit_rms_px = fit->rms_px;
+      p.support = fit->support;
+      bool ok = true;
+      // Block corners: pixel borders at -0.5 offsets.
+      const double xs[4] = {ex0, ex1, ex1, ex0};
+      const double ys[4] = {ey0, ey0, ey1, ey1};
+      for (int c = 0; c < 4; ++c) {
+        const double d = (*fit)(xs[c], ys[c]);
+        if (!(d > 0.05)) {
+          ok = false;
+          break;
+        }
+        const double z = k.fx_px * baseline_m / d;
+        p.corners_W[c] = left.world_T_camera * (z * k.Ray({xs[c], ys[c]}));
+      }
+      if (ok) map.Add(p);
+    }
+  }
+  return map;
+}
+
+IdrResult RunIdr(rig::Rig& rig, const IdrOptions& options) {
+  options.Check();
+  IdrResult result;
+  const rig::RigLimits& limits = rig.Limits();
+  const rig::AxisLimit& lb = limits[rig::Axis::kLeftBaseline];
+  const rig::AxisLimit& rb = limits[rig::Axis::kRightBaseline];
+  // The left camera stays put (its image and crossings anchor every stage);
+  // the right carriage sets the baseline.
+  const double left_x = lb.max;
+  const double min_baseline = rb.min - left_x, max_baseline = rb.max - left_x;
+  auto parallel = [&](double baseline) {
+    rig::StageState s;
+    s.left.baseline_m = left_x;
+    s.right.baseline_m = std::clamp(left_x + baseline, rb.min, rb.max);
+    return s;
+  };
+  auto move_and_capture = [&](double baseline, IdrStage* stage) {
+    const rig::MoveResult move = rig.MoveTo(parallel(baseline));
+    if (stage) stage->motion_time_s = move.motion_time_s;
+    result.motion_time_s += move.motion_time_s;
+    return rig.Capture();
+  };
+
+  // Initial baseline from one image (section II-A).
+  rig::StereoFrame frame = move_and_capture(min_baseline, nullptr);
+  const double f = frame.left.intrinsics.fx_px;
+  auto t0 = Clock::now();
+  ZeroCrossingImage zc_left = ExtractZeroCrossings(frame.left.gray, options.zero_crossings);
+  const double d_max0 = UnambiguousDisparityLimit(SamePolarityPeriods(zc_left), options.unique_share);
+  double baseline = options.fixed_initial_baseline_m > 0 ? options.fixed_initial_baseline_m
+                                                         : d_max0 * options.z_min_m / f;
+  baseline = std::clamp(baseline, min_baseline, max_baseline);
+  double search_limit = options.fixed_initial_baseline_m > 0 ? f * baseline / options.z_min_m : d_max0;
+  result.compute_time_s += Since(t0);
+
+  DisparityWindows left_windows, right_windows;
+  left_windows.global = right_windows.global = true;
+  left_windows.global_lo_px = right_windows.global_lo_px = -0.25;
+  left_windows.global_hi_px = right_windows.global_hi_px = search_limit + 0.25;
+
+  for (int s = 0; s < options.max_stages; ++s) {
+    IdrStage stage;
+    frame = move_and_capture(baseline, &stage);
+    t0 = Clock::now();
+    // The actual baseline, from the camera poses (quantized and settled).
+    const double b = (frame.right.world_T_camera.translation() - frame.left.world_T_camera.translation()).norm();
+    stage.baseline_m = b;
+    stage.search_limit_px = left_windows.global ? left_windows.global_hi_px : 0;
+    zc_left = ExtractZeroCrossings(frame.left.gray, options.zero_crossings);
+    const ZeroCrossingImage zc_right = ExtractZeroCrossings(frame.right.gray, options.zero_crossings);
+    const auto matches = MatchZeroCrossings(zc_left, zc_right, left_windows, right_windows,
+                                            options.matching, &stage.stats);
+    std::vector<DisparitySample> samples;
+    samples.reserve(matches.size());
+    std::vector<char> matched(zc_left.crossings.size(), 0);
+    for (const ZcMatch& m : matches) matched[m.left] = 1;
+    std::vector<Eigen::Vector2d> unmatched;
+    for (size_t i = 0; i < zc_left.crossings.size(); ++i) {
+      const ZeroCrossing& z = zc_left.crossings[i];
+      double lo, hi;
+      if (!matched[i] && left_windows.Window(z.x_px, z.y_px, &lo, &hi)) unmatched.emplace_back(z.x_px, z.y_px);
+    }
+    std::vector<double> disparities, separations;
+    const std::vector<float> periods = SamePolarityPeriods(zc_left);
+    for (const ZcMatch& m : matches) {
+      const ZeroCrossing& z = zc_left.crossings[m.left];
+      samples.push_back({z.x_px, static_cast<double>(z.y_px), m.disparity_px});
+      disparities.push_back(m.disparity_px);
+      if (std::isfinite(periods[m.left])) separations.push_back(periods[m.left]);
+    }
+    stage.max_disparity_px = Quantile(disparities, 0.99);
+    // s_min: the separation that all but (1 - unique_share) of crossings exceed.
+    stage.min_separation_px = Quantile(separations, 1 - options.unique_share);
+
+    result.final_frame = frame;
+    result.final_samples = samples;
+    result.final_unmatched = unmatched;
+    const std::vector<char> at_edge = NearDiscontinuity(samples, 2 * options.zero_crossings.sigma_px,
+                                                        options.discontinuity_jump_px);
+    std::vector<DisparitySample> smooth;
+    for (size_t i = 0; i < samples.size(); ++i)
+      if (!at_edge[i]) smooth.push_back(samples[i]);
+    result.map = PatchesFromDisparities(smooth, frame.left, b, options.patch_size_px,
+                                        options.plane_fit, PatchLevel::kIdr);
+
+    // Candidate first fixation: the well-supported patch nearest the centre.
+    const rig::CameraIntrinsics& k = frame.left.intrinsics;
+    const Eigen::Isometry3d camera_T_world = frame.left.world_T_camera.inverse();
+    double best = 1e300;
+    result.has_fixation = false;
+    for (size_t i = 0; i < result.map.size(); ++i) {
+      const Patch& p = result.map.patches()[i];
+      if (p.support < 2 * options.plane_fit.min_support) continue;
+      const Eigen::Vector3d c_C = camera_T_world * p.Centre();
+      const double r = std::hypot(k.fx_px * c_C.x() / c_C.z(), k.fy_px * c_C.y() / c_C.z());
+      if (r < best) {
+        best = r;
+        result.has_fixation = true;
+        result.first_fixation_W = p.Centre();
+        result.first_fixation_patch = static_cast<int>(i);
+      }
+    }
+
+    // Termination (section II-C): the IDR depth uncertainty at the fixation,
+    // Z^2 0.5 / (f B), within what the vergent stage disambiguates with a
+    // +-P px search at its baseline, Z^2 P / (f B_v).
+    double expansion = 1;
+    const bool precise_enough = b >= 0.5 * options.vergent_baseline_m / options.vergent_search_px;
+    if (precise_enough && result.has_fixation) {
+      result.stop_reason = "depth precise enough to verge";
+    } else if (s + 1 == options.max_stages) {
+      result.stop_reason = "stage budget spent";
+    } else if (matches.empty()) {
+      result.stop_reason = "no matches";
+    } else {
+      expansion = std::min(options.max_expansion,
+                           ExpansionFactor(stage.min_separation_px, stage.max_disparity_px, f,
+                                           options.max_slant_deg * M_PI / 180));
+      expansion = std::min(expansion, max_baseline / b);
+      if (expansion < options.min_expansion) {
+        result.stop_reason = b >= max_baseline - 1e-9 ? "widest baseline reached" : "expansion factor too small";
+        expansion = 1;
+      }
+    }
+    stage.expansion_factor = expansion;
+    if (expansion > 1) {
+      // Windows for the next stage: each match predicts k (d +- 0.5), at its
+      // left position and at its predicted right position.
+      left_windows = DisparityWindows();
+      right_windows = DisparityWindows();
+      left_windows.global = right_windows.global = false;
+      left_windows.rows.assign(frame.left.intrinsics.height_px, {});
+      right_windows.rows.assign(frame.left.intrinsics.height_px, {});
+      left_windows.reach_px = right_windows.reach_px = std::max(2.0, 0.5 * stage.min_separation_px);
+      for (const DisparitySample& m : samples) {
+        const float lo = static_cast<float>(expansion * (m.disparity_px - 0.5));
+        const float hi = static_cast<float>(expansion * (m.disparity_px + 0.5));
+        const int y = static_cast<int>(m.y_px);
+        left_windows.rows[y].push_back({static_cast<float>(m.x_px), lo, hi});
+        right_windows.rows[y].push_back({static_cast<float>(m.x_px - expansion * m.disparity_px), lo, hi});
+      }
+      for (auto* w : {&left_windows, &right_windows})
+        for (auto& row : w->rows)
+          std::sort(row.begin(), row.end(), [](const auto& a, const auto& b) { return a.x_px < b.x_px; });
+    }
+    stage.compute_time_s = Since(t0);
+    result.compute_time_s += stage.compute_time_s;
+    result.stages.push_back(stage);
+    if (expansion <= 1) break;
+    baseline = b * expansion;
+  }
+  return result;
+}
+
+}  // namespace fovea

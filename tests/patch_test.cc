@@ -1,0 +1,103 @@
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "fovea/patch.h"
+
+namespace {
+std::vector<fovea::DisparitySample> PlaneSamples(double a, double b, double c, double x0, double y0,
+                                                 int size, int step) {
+  std::vector<fovea::DisparitySample> s;
+  for (int y = 0; y < size; y += step)
+    for (int x = 0; x < size; x += step) s.push_back({x0 + x + 0.3, y0 + y, a * (x0 + x + 0.3) + b * (y0 + y) + c});
+  return s;
+}
+fovea::Patch Square(double z, double half) {
+  fovea::Patch p;
+  p.corners_W = {Eigen::Vector3d(-half, -half, z), Eigen::Vector3d(half, -half, z),
+                 Eigen::Vector3d(half, half, z), Eigen::Vector3d(-half, half, z)};
+  return p;
+}
+}  // namespace
+
+TEST_CASE("a plane is fitted exactly from samples on it", "[fovea][patch]") {
+  const auto samples = PlaneSamples(0.05, -0.02, 30, 32, 48, 16, 3);
+  Eigen::Vector4d box;
+  const auto fit = fovea::FitDisparityPlane(samples, 32, 48, 16, {}, &box);
+  REQUIRE(fit);
+  CHECK(fit->a == Approx(0.05).margin(1e-9));
+  CHECK(fit->b == Approx(-0.02).margin(1e-9));
+  CHECK(fit->c == Approx(30).margin(1e-7));
+  CHECK(fit->rms_px < 1e-9);
+  CHECK(fit->support == int(samples.size()));
+  CHECK(box(0) == Approx(32.3));
+  CHECK(box(2) == Approx(47.3));
+}
+
+TEST_CASE("plane fitting drops outliers and rejects mixed or thin support", "[fovea][patch]") {
+  auto samples = PlaneSamples(0, 0, 20, 0, 0, 16, 2);  // 64 samples
+  const int n = int(samples.size());
+  samples[5].disparity_px += 15;  // two wrong matches
+  samples[40].disparity_px -= 9;
+  const auto fit = fovea::FitDisparityPlane(samples, 0, 0, 16, {});
+  REQUIRE(fit);
+  CHECK(fit->support == n - 2);
+  CHECK(fit->c == Approx(20).margin(1e-9));
+
+  // A depth step through the block: two populations, rejected.
+  auto step = PlaneSamples(0, 0, 20, 0, 0, 16, 2);
+  for (auto& s : step)
+    if (s.x_px > 8) s.disparity_px = 35;
+  CHECK_FALSE(fovea::FitDisparityPlane(step, 0, 0, 16, {}));
+
+  // Too few samples; all on one row; one quadrant empty.
+  CHECK_FALSE(fovea::FitDisparityPlane(PlaneSamples(0, 0, 20, 0, 0, 16, 8), 0, 0, 16, {}));
+  std::vector<fovea::DisparitySample> row;
+  for (int x = 0; x < 16; ++x) row.push_back({double(x), 3, 20});
+  CHECK_FALSE(fovea::FitDisparityPlane(row, 0, 0, 16, {}));
+  auto corner = PlaneSamples(0, 0, 20, 0, 0, 16, 1);
+  corner.erase(std::remove_if(corner.begin(), corner.end(),
+                              [](const auto& s) { return s.x_px >= 8 && s.y_px >= 8; }),
+               corner.end());
+  CHECK_FALSE(fovea::FitDisparityPlane(corner, 0, 0, 16, {}));
+}
+
+TEST_CASE("patch map: rays hit the nearest patch", "[fovea][patch]") {
+  fovea::PatchMap map;
+  map.Add(Square(2.0, 0.5));
+  map.Add(Square(1.0, 0.1));
+  const auto hit = map.CastRay(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ());
+  REQUIRE(hit);
+  CHECK(hit->patch == 1);
+  CHECK(hit->distance_m == Approx(1.0));
+  const auto far = map.CastRay(Eigen::Vector3d(0.3, 0, 0), Eigen::Vector3d::UnitZ());
+  REQUIRE(far);
+  CHECK(far->patch == 0);
+  CHECK(far->distance_m == Approx(2.0));
+  CHECK_FALSE(map.CastRay(Eigen::Vector3d(0.7, 0, 0), Eigen::Vector3d::UnitZ()));
+  CHECK(map.patches()[0].Normal().z() == Approx(1));
+  CHECK(map.patches()[0].SizeM() == Approx(std::sqrt(2.0)));
+}
+
+TEST_CASE("patch map: rendering into a view gives depth and patch ids", "[fovea][patch]") {
+  fovea::PatchMap map;
+  map.Add(Square(2.0, 0.5));
+  map.Add(Square(1.0, 0.1));
+  const auto k = rig::CameraIntrinsics::FromHorizontalFov(200, 150, 1.0);
+  cv::Mat depth, ids;
+  map.Render(Eigen::Isometry3d::Identity(), k, &depth, &ids);
+  CHECK(depth.at<float>(75, 100) == Approx(1.0f));  // the near patch covers the centre
+  CHECK(ids.at<int>(75, 100) == 1);
+  // 0.3 m off-axis at 2 m: only the far patch.
+  const int u = int(std::lround(k.cx_px + k.fx_px * 0.3 / 2.0));
+  CHECK(depth.at<float>(75, u) == Approx(2.0f));
+  CHECK(ids.at<int>(75, u) == 0);
+  CHECK(depth.at<float>(2, 2) == 0);  // 0.5 m square at 2 m leaves the corners empty
+  CHECK(ids.at<int>(2, 2) == -1);
+  // Agrees with ray casting everywhere it is set.
+  for (int v = 0; v < 150; v += 10)
+    for (int x = 0; x < 200; x += 10) {
+      const auto hit = map.CastRay(Eigen::Vector3d::Zero(), k.Ray({double(x), double(v)}).normalized());
+      if (!hit) continue;
+      CHECK(depth.at<float>(v, x) == Approx(hit->distance_m / k.Ray({double(x), double(v)}).norm()).epsilon(1e-5));
+    }
+}
