@@ -131,17 +131,59 @@ std::vector<ZcMatch> MatchZeroCrossings(const ZeroCrossingImage& left, const Zer
   return matches;
 }
 
+namespace {
+// Samples bucketed in square cells, for neighbourhood queries.
+class SampleGrid {
+ public:
+  SampleGrid(const std::vector<DisparitySample>& samples, double cell) : samples_(samples), cell_(std::max(1.0, cell)) {
+    for (size_t i = 0; i < samples.size(); ++i) grid_[Key(samples[i].x_px, samples[i].y_px)].push_back(static_cast<int>(i));
+  }
+  // Indices of samples within `radius` of sample i (not i itself).
+  template <typename F>
+  void ForNeighbours(size_t i, double radius, F&& f) const {
+    const DisparitySample& a = samples_[i];
+    const int reach = static_cast<int>(std::ceil(radius / cell_));
+    for (int dy = -reach; dy <= reach; ++dy)
+      for (int dx = -reach; dx <= reach; ++dx) {
+        const auto it = grid_.find(Key(a.x_px + dx * cell_, a.y_px + dy * cell_));
+        if (it == grid_.end()) continue;
+        for (int j : it->second) {
+          if (j == static_cast<int>(i)) continue;
+          const double ddx = a.x_px - samples_[j].x_px, ddy = a.y_px - samples_[j].y_px;
+          if (ddx * ddx + ddy * ddy <= radius * radius) f(j);
+        }
+      }
+  }
+
+ private:
+  long long Key(double x, double y) const {
+    return (static_cast<long long>(std::floor(y / cell_)) << 32) ^ static_cast<long long>(std::floor(x / cell_) + (1 << 30));
+  }
+  const std::vector<DisparitySample>& samples_;
+  double cell_;
+  std::unordered_map<long long, std::vector<int>> grid_;
+};
+}  // namespace
+
+std::vector<char> IsolatedOutliers(const std::vector<DisparitySample>& samples, double radius_px,
+                                   double jump_px) {
+  std::vector<char> flags(samples.size(), 0);
+  const SampleGrid grid(samples, radius_px);
+  std::vector<double> near;
+  for (size_t i = 0; i < samples.size(); ++i) {
+    near.clear();
+    grid.ForNeighbours(i, radius_px, [&](int j) { near.push_back(samples[j].disparity_px); });
+    if (near.size() < 3) continue;
+    std::nth_element(near.begin(), near.begin() + near.size() / 2, near.end());
+    if (std::abs(samples[i].disparity_px - near[near.size() / 2]) > jump_px) flags[i] = 1;
+  }
+  return flags;
+}
+
 std::vector<char> NearDiscontinuity(const std::vector<DisparitySample>& samples, double radius_px,
                                     double jump_px) {
   std::vector<char> flags(samples.size(), 0);
   if (samples.empty()) return flags;
-  // Bucket by cells of radius_px; compare with the 3 x 3 neighbouring cells.
-  const double cell = std::max(1.0, radius_px);
-  std::unordered_map<long long, std::vector<int>> grid;
-  auto key = [&](double x, double y) {
-    return (static_cast<long long>(std::floor(y / cell)) << 32) ^ static_cast<long long>(std::floor(x / cell) + (1 << 30));
-  };
-  for (size_t i = 0; i < samples.size(); ++i) grid[key(samples[i].x_px, samples[i].y_px)].push_back(static_cast<int>(i));
   // Along each row, consecutive samples (whatever their distance) that jump
   // bracket a discontinuity.
   std::unordered_map<int, std::vector<int>> rows;
@@ -152,22 +194,12 @@ std::vector<char> NearDiscontinuity(const std::vector<DisparitySample>& samples,
       if (std::abs(samples[idx[k]].disparity_px - samples[idx[k - 1]].disparity_px) > jump_px)
         flags[idx[k]] = flags[idx[k - 1]] = 1;
   }
-  const double r2 = radius_px * radius_px;
+  const SampleGrid grid(samples, radius_px);
   for (size_t i = 0; i < samples.size(); ++i) {
-    const DisparitySample& a = samples[i];
-    for (int dy = -1; dy <= 1 && !flags[i]; ++dy)
-      for (int dx = -1; dx <= 1 && !flags[i]; ++dx) {
-        const auto it = grid.find(key(a.x_px + dx * cell, a.y_px + dy * cell));
-        if (it == grid.end()) continue;
-        for (int j : it->second) {
-          const DisparitySample& b = samples[j];
-          const double ddx = a.x_px - b.x_px, ddy = a.y_px - b.y_px;
-          if (ddx * ddx + ddy * ddy <= r2 && std::abs(a.disparity_px - b.disparity_px) > jump_px) {
-            flags[i] = 1;
-            break;
-          }
-        }
-      }
+    if (flags[i]) continue;
+    grid.ForNeighbours(i, radius_px, [&](int j) {
+      if (std::abs(samples[i].disparity_px - samples[j].disparity_px) > jump_px) flags[i] = 1;
+    });
   }
   return flags;
 }
@@ -321,11 +353,16 @@ IdrResult RunIdr(rig::Rig& rig, const IdrOptions& options) {
     result.final_frame = frame;
     result.final_samples = samples;
     result.final_unmatched = unmatched;
-    const std::vector<char> at_edge = NearDiscontinuity(samples, 2 * options.zero_crossings.sigma_px,
-                                                        options.discontinuity_jump_px);
-    std::vector<DisparitySample> smooth;
+    // Drop isolated wrong matches, then the matches at depth discontinuities.
+    const double radius = 2 * options.zero_crossings.sigma_px;
+    const std::vector<char> outlier = IsolatedOutliers(samples, radius, options.discontinuity_jump_px);
+    std::vector<DisparitySample> clean;
     for (size_t i = 0; i < samples.size(); ++i)
-      if (!at_edge[i]) smooth.push_back(samples[i]);
+      if (!outlier[i]) clean.push_back(samples[i]);
+    const std::vector<char> at_edge = NearDiscontinuity(clean, radius, options.discontinuity_jump_px);
+    std::vector<DisparitySample> smooth;
+    for (size_t i = 0; i < clean.size(); ++i)
+      if (!at_edge[i]) smooth.push_back(clean[i]);
     result.map = PatchesFromDisparities(smooth, frame.left, b, options.patch_size_px,
                                         options.plane_fit, PatchLevel::kIdr);
 

@@ -137,7 +137,7 @@ Mat Fabric(cv::RNG& rng, int size) {
 }
 
 Mat Plywood(cv::RNG& rng, int size) {
-  Mat out = Grain(rng, size, 9, 0.35, 0.3, {110, 160, 200}, {175, 215, 240});
+  Mat out = Grain(rng, size, 9, 0.35, 0.6, {70, 120, 170}, {185, 222, 245});
   // A few dark knots.
   const int knots = rng.uniform(2, 5);
   for (int k = 0; k < knots; ++k) {

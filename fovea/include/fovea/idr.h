@@ -67,6 +67,13 @@ std::vector<ZcMatch> MatchZeroCrossings(const ZeroCrossingImage& left, const Zer
                                         const DisparityWindows& right_windows,
                                         const ZcMatchOptions& options, ZcMatchStats* stats);
 
+/// Flags isolated outliers: samples whose disparity differs by more than
+/// `jump_px` from the median of their neighbours within `radius_px` (at
+/// least 3 of them). Isolated wrong matches would otherwise look like depth
+/// discontinuities.
+std::vector<char> IsolatedOutliers(const std::vector<DisparitySample>& samples, double radius_px,
+                                   double jump_px);
+
 /// Flags samples that lie at a depth discontinuity: another sample within
 /// `radius_px`, or the next sample along its row at any distance, whose
 /// disparity differs by more than `jump_px`.
