@@ -1,0 +1,49 @@
+// Visual servoing of the fixation (paper section III): find the disparity of
+// the left image's centre window in the right image with the normalized L1
+// cost, and null it by turning the right camera.
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <optional>
+#include <vector>
+
+#include "rig/rig.h"
+
+namespace fovea {
+
+/// Normalized L1 cost of two (2 half + 1)^2 windows centred at integer
+/// pixels: mean over the window of |(L - mean L) - (R - mean R)|, grey
+/// levels. Windows must lie inside their images.
+double NormalizedL1(const cv::Mat& left, int xl, int yl, const cv::Mat& right, int xr, int yr, int half);
+
+struct ServoOptions {
+  int window_half_px = 15;     ///< a 31 x 31 window
+  int search_px = 40;          ///< horizontal search +- this many pixels
+  double tolerance_px = 0.5;   ///< done when the residual disparity is below this
+  int max_steps = 6;           ///< step budget
+  void Check() const;
+};
+
+/// Where the left image's centre window appears in the right image, as a
+/// horizontal offset in pixels from the right principal point (sub-pixel by
+/// a parabola through the cost minimum); nullopt if the minimum is at the
+/// edge of the search or the window has no texture (mean absolute deviation
+/// under 2 grey levels).
+std::optional<double> CentreDisparity(const rig::StereoFrame& frame, const ServoOptions& options);
+
+struct ServoResult {
+  bool converged = false;
+  int iterations = 0;                ///< moves made after the first
+  double residual_px = 0;            ///< last measured centre disparity
+  std::vector<double> residuals_px;  ///< one per measurement
+  rig::StageState state;             ///< where the rig ended
+  rig::StereoFrame frame;            ///< the last pair captured
+  double motion_time_s = 0;
+};
+
+/// Moves to `start`, then repeats: capture, measure the centre disparity d,
+/// turn the right camera by -atan(d / f), until |d| < tolerance or the step
+/// budget is spent. Throws rig::RigError if the rig refuses a move.
+ServoResult Servo(rig::Rig& rig, const rig::StageState& start, const ServoOptions& options);
+
+}  // namespace fovea

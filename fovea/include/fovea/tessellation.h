@@ -1,0 +1,60 @@
+// The foveal tessellation (paper section III; design note "Foveated vergent
+// stereo", step 3): nested, centred rectangles of decreasing resolution,
+// sized so that vertical disparity stays under half a pixel of each level and
+// plain scanline matching holds everywhere.
+#pragma once
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "fovea/patch.h"
+#include "rig/types.h"
+
+namespace fovea {
+
+struct TessellationOptions {
+  /// Full-resolution horizontal disparity limit of the fovea's search: Z_T
+  /// is the depth offset at which a point on the left optical axis reaches
+  /// half of it.
+  double horizontal_disparity_limit_px = 32;
+  int max_levels = 4;  ///< level k samples every 2^k pixels
+  void Check() const;
+};
+
+struct Tessellation {
+  double fixation_depth_m = 0;  ///< Z of the fixation point in the left camera
+  double z_t_near_m = 0;        ///< Z_T in front of the fixation (positive)
+  double z_t_far_m = 0;         ///< Z_T behind it (positive)
+  double z_max_near_m = 0;      ///< worst-case plane offsets used (map, limited by Z_T)
+  double z_max_far_m = 0;
+  /// Per level k: the centred rectangle (full-resolution pixels) inside
+  /// which level k applies; level 0 innermost, the last one the whole image.
+  std::vector<cv::Rect> rects;
+  /// Worst-case |vertical disparity| per left pixel, px (CV_32F).
+  cv::Mat vertical_disparity_px;
+  /// CV_8U: 255 where matching may run, 0 where the map puts the surface
+  /// beyond Z_T of the fixation.
+  cv::Mat mask;
+
+  /// The finest level whose rectangle contains the pixel.
+  int LevelAt(int u, int v) const;
+};
+
+/// Worst-case |vertical disparity| per left pixel for points on the left-camera
+/// fronto-parallel planes at the given depths (max over the planes), by real
+/// projection into the right camera.
+cv::Mat VerticalDisparity(const rig::CameraView& left, const rig::CameraView& right,
+                          const std::vector<double>& plane_depths_m);
+
+/// Horizontal disparity (u_right - cx_right) of the point on the left
+/// optical axis at depth z_m.
+double AxisHorizontalDisparity(const rig::CameraView& left, const rig::CameraView& right, double z_m);
+
+/// Builds the tessellation for a verged pair fixating p_W, using the map's
+/// depths in the left view for Z_max and the mask.
+Tessellation Tessellate(const rig::CameraView& left, const rig::CameraView& right,
+                        const Eigen::Vector3d& fixation_W, const PatchMap& map,
+                        const TessellationOptions& options);
+
+}  // namespace fovea

@@ -1,0 +1,115 @@
+#include "fovea/tessellation.h"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace fovea {
+
+void TessellationOptions::Check() const {
+  if (!(horizontal_disparity_limit_px > 0)) throw std::invalid_argument("tessellation: horizontal_disparity_limit_px must be positive");
+  if (max_levels < 1 || max_levels > 6) throw std::invalid_argument("tessellation: max_levels must be 1 to 6");
+}
+
+int Tessellation::LevelAt(int u, int v) const {
+  for (size_t k = 0; k < rects.size(); ++k)
+    if (rects[k].contains({u, v})) return static_cast<int>(k);
+  return static_cast<int>(rects.size()) - 1;
+}
+
+cv::Mat VerticalDisparity(const rig::CameraView& left, const rig::CameraView& right,
+                          const std::vector<double>& depths) {
+  const rig::CameraIntrinsics& kl = left.intrinsics;
+  const rig::CameraIntrinsics& kr = right.intrinsics;
+  const Eigen::Isometry3d right_T_left = right.world_T_camera.inverse() * left.world_T_camera;
+  cv::Mat out(kl.height_px, kl.width_px, CV_32F, cv::Scalar(0));
+  for (int v = 0; v < kl.height_px; ++v) {
+    float* row = out.ptr<float>(v);
+    for (int u = 0; u < kl.width_px; ++u) {
+      const Eigen::Vector3d ray = kl.Ray({u, v});  // z = 1
+      for (double z : depths) {
+        const Eigen::Vector3d p_R = right_T_left * (z * ray);
+        if (p_R.z() <= 0) continue;
+        const double vr = kr.fy_px * p_R.y() / p_R.z() + kr.cy_px;
+        row[u] = std::max(row[u], static_cast<float>(std::abs(vr - v)));
+      }
+    }
+  }
+  return out;
+}
+
+double AxisHorizontalDisparity(const rig::CameraView& left, const rig::CameraView& right, double z) {
+  const Eigen::Vector3d p_W = left.world_T_camera * Eigen::Vector3d(0, 0, z);
+  const Eigen::Vector3d p_R = right.world_T_camera.inverse() * p_W;
+  return right.intrinsics.fx_px * p_R.x() / p_R.z();
+}
+
+Tessellation Tessellate(const rig::CameraView& left, const rig::CameraView& right,
+                        const Eigen::Vector3d& fixation_W, const PatchMap& map,
+                        const TessellationOptions& options) {
+  options.Check();
+  Tessellation t;
+  const rig::CameraIntrinsics& k = left.intrinsics;
+  t.fixation_depth_m = (left.world_T_camera.inverse() * fixation_W).z();
+  const double z0 = t.fixation_depth_m;
+  const double d0 = AxisHorizontalDisparity(left, right, z0);
+  const double half_limit = 0.5 * options.horizontal_disparity_limit_px;
+  // Z_T on each side by bisection on the real projection.
+  auto solve = [&](double sign, double max_offset) {
+    double lo = 0, hi = max_offset;
+    if (std::abs(AxisHorizontalDisparity(left, right, z0 + sign * hi) - d0) < half_limit) return hi;
+    for (int i = 0; i < 60; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      (std::abs(AxisHorizontalDisparity(left, right, z0 + sign * mid) - d0) < half_limit ? lo : hi) = mid;
+    }
+    return 0.5 * (lo + hi);
+  };
+  t.z_t_far_m = solve(+1, 20.0);
+  t.z_t_near_m = solve(-1, std::max(0.0, z0 - 0.05));
+
+  // Z_max from the map in view, limited to Z_T; the mask from the same depths.
+  cv::Mat depth;
+  map.Render(left.world_T_camera, k, &depth, nullptr);
+  t.mask = cv::Mat(k.height_px, k.width_px, CV_8U, cv::Scalar(255));
+  for (int v = 0; v < k.height_px; ++v)
+    for (int u = 0; u < k.width_px; ++u) {
+      const float z = depth.at<float>(v, u);
+      if (z <= 0) continue;
+      const double off = z - z0;
+      if (off > t.z_t_far_m || -off > t.z_t_near_m) {
+        t.mask.at<uchar>(v, u) = 0;
+        continue;
+      }
+      t.z_max_far_m = std::max(t.z_max_far_m, off);
+      t.z_max_near_m = std::max(t.z_max_near_m, -off);
+    }
+  t.vertical_disparity_px =
+      VerticalDisparity(left, right, {z0 - t.z_max_near_m, z0, z0 + t.z_max_far_m});
+
+  // Level k holds where |vertical disparity| < 0.5 * 2^k: the largest centred
+  // rectangle of the image's shape that excludes every violating pixel.
+  const double cx = k.cx_px, cy = k.cy_px, hw = 0.5 * k.width_px, hh = 0.5 * k.height_px;
+  for (int level = 0; level < options.max_levels; ++level) {
+    const float threshold = static_cast<float>(0.5 * std::pow(2.0, level));
+    double scale = 1.0;
+    for (int v = 0; v < k.height_px; ++v) {
+      const float* row = t.vertical_disparity_px.ptr<float>(v);
+      for (int u = 0; u < k.width_px; ++u)
+        if (row[u] >= threshold)
+          scale = std::min(scale, std::max(std::abs(u - cx) / hw, std::abs(v - cy) / hh));
+    }
+    const bool last = level + 1 == options.max_levels || scale >= 1.0;
+    if (last) scale = 1.0;
+    // Pixels strictly inside |u - cx| < scale hw, |v - cy| < scale hh.
+    const int x0 = static_cast<int>(std::floor(cx - scale * hw)) + 1, x1 = static_cast<int>(std::ceil(cx + scale * hw)) - 1;
+    const int y0 = static_cast<int>(std::floor(cy - scale * hh)) + 1, y1 = static_cast<int>(std::ceil(cy + scale * hh)) - 1;
+    cv::Rect r(std::max(0, x0), std::max(0, y0), 0, 0);
+    r.width = std::min(k.width_px - 1, x1) - r.x + 1;
+    r.height = std::min(k.height_px - 1, y1) - r.y + 1;
+    if (last) r = cv::Rect(0, 0, k.width_px, k.height_px);
+    t.rects.push_back(r);
+    if (last) break;
+  }
+  return t;
+}
+
+}  // namespace fovea
