@@ -47,7 +47,8 @@ case "${1:-}" in
     build build -DCMAKE_BUILD_TYPE=Release
     ctest --test-dir build -j "$JOBS" --output-on-failure
     # Memory errors and undefined behaviour fail the suite too.
-    build build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFOVEA_SANITIZE=ON
+    # -O1, no debug info: the usual sanitizer setting, and half the build time.
+    build build-asan -DCMAKE_BUILD_TYPE=None -DCMAKE_CXX_FLAGS=-O1 -DFOVEA_SANITIZE=ON
     ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
       LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp:print_suppressions=0 \
       UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \

@@ -12,5 +12,6 @@ void AddRenderCommand(CLI::App& app, std::function<int()>* run);
 void AddBenchCommand(CLI::App& app, std::function<int()>* run);
 void AddCatalogCommands(CLI::App& app, std::function<int()>* run);
 void AddIdrCommand(CLI::App& app, std::function<int()>* run);
+void AddFixateCommand(CLI::App& app, std::function<int()>* run);
 
 }  // namespace experiments

@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   experiments::AddBenchCommand(app, &run);
   experiments::AddCatalogCommands(app, &run);
   experiments::AddIdrCommand(app, &run);
+  experiments::AddFixateCommand(app, &run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -157,7 +157,10 @@ class SampleGrid {
 
  private:
   long long Key(double x, double y) const {
-    return (static_cast<long long>(std::floor(y / cell_)) << 32) ^ static_cast<long long>(std::floor(x / cell_) + (1 << 30));
+    // Cell indices offset to be non-negative, packed into 64 bits.
+    const auto ix = static_cast<unsigned long long>(static_cast<long long>(std::floor(x / cell_)) + (1LL << 30));
+    const auto iy = static_cast<unsigned long long>(static_cast<long long>(std::floor(y / cell_)) + (1LL << 30));
+    return static_cast<long long>((iy << 32) | (ix & 0xffffffffULL));
   }
   const std::vector<DisparitySample>& samples_;
   double cell_;

@@ -1,0 +1,77 @@
+// Foveated vergent stereo at one fixation (paper section III; design note
+// "Foveated vergent stereo"): verge, servo, tessellate, match each level,
+// make patches.
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "fovea/matcher.h"
+#include "fovea/patch.h"
+#include "fovea/servo.h"
+#include "fovea/tessellation.h"
+#include "fovea/vergence.h"
+#include "rig/rig.h"
+
+namespace fovea {
+
+struct FovealOptions {
+  TessellationOptions tessellation;
+  int fovea_patch_px = 8;       ///< patch size at level 0, in its pixels
+  int periphery_patch_px = 16;  ///< patch size at coarser levels, in their pixels
+  PlaneFitOptions plane_fit{/*min_support=*/12, /*fit_tolerance_px=*/1.0, /*min_inlier_share=*/0.8,
+                            /*require_quadrants=*/true};
+  double map_margin_px = 2.0;   ///< search +- this many level pixels around the map's prediction
+  double coarse_margin_px = 1.5;  ///< and around the coarser level's estimate
+  void Check() const;
+};
+
+/// Figures of one resolution level.
+struct LevelFigures {
+  int level = 0;
+  cv::Rect rect;            ///< full-resolution pixels the level covers
+  int searched = 0, matched = 0, patches = 0;
+  double match_time_s = 0;
+};
+
+struct FovealResult {
+  Tessellation tessellation;
+  std::vector<cv::Mat> disparity_px;  ///< per level, at its resolution (NaN = none)
+  std::vector<LevelFigures> levels;
+  PatchMap patches;                   ///< foveal (level 0) and peripheral patches
+  double compute_time_s = 0;
+};
+
+/// Matches a verged pair that fixates p_W, level by level, coarse to fine,
+/// with the range at each pixel bounded by `map` (or by Z_T where the map is
+/// silent), and fits patches: `fixation` is recorded in each patch.
+FovealResult FovealStereo(const rig::StereoFrame& frame, const Eigen::Vector3d& fixation_W,
+                          const PatchMap& map, const StereoMatcher& matcher,
+                          const FovealOptions& options, int fixation = 0);
+
+/// Everything one fixation does on the rig.
+struct FixationOptions {
+  VergenceOptions vergence;
+  ServoOptions servo;
+  FovealOptions foveal;
+  double baseline_m = 0.12;  ///< vergent baseline, symmetric about the rail centre
+  void Check() const;
+};
+
+struct FixationResult {
+  bool ok = false;
+  std::string why;                   ///< when not ok: why the point could not be fixated
+  VergenceSolution vergence;
+  ServoResult servo;
+  Eigen::Vector3d fixation_W = Eigen::Vector3d::Zero();  ///< where the optical axes meet after servoing
+  FovealResult foveal;
+  double motion_time_s = 0, compute_time_s = 0;
+};
+
+/// Verges on p_W, servos, captures and runs the foveated stereo.
+FixationResult Fixate(rig::Rig& rig, const PatchMap& map, const Eigen::Vector3d& p_W,
+                      const StereoMatcher& matcher, const FixationOptions& options, int fixation = 0);
+
+}  // namespace fovea

@@ -1,0 +1,50 @@
+// Scanline stereo matchers for the foveated stage: any reasonable algorithm
+// may be plugged in (paper section III-C). Images are one resolution level of
+// the unrectified vergent pair; disparities are signed, d = x_left - x_right.
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <string>
+
+namespace fovea {
+
+/// Per-pixel disparity at one level: NaN where there is none.
+struct DisparityMap {
+  cv::Mat disparity_px;  ///< CV_32F
+  cv::Mat confidence;    ///< CV_32F in [0, 1]; 0 where no disparity
+  int searched = 0, matched = 0, rejected_texture = 0, rejected_lr = 0, rejected_edge = 0;
+};
+
+class StereoMatcher {
+ public:
+  virtual ~StereoMatcher() = default;
+  /// Matches every left pixel with lo_px <= hi_px (CV_32F maps, same size as
+  /// the images) along its row, searching d in [lo, hi].
+  virtual DisparityMap Match(const cv::Mat& left, const cv::Mat& right, const cv::Mat& lo_px,
+                             const cv::Mat& hi_px) const = 0;
+  virtual std::string Name() const = 0;
+};
+
+struct Nl1Options {
+  int window_half_px = 3;        ///< a 7 x 7 window
+  double min_texture_dn = 2.0;   ///< mean absolute deviation of the left window
+  double lr_tolerance_px = 1.0;  ///< left-right check
+  void Check() const;
+};
+
+/// Normalized L1 window matching (the paper's cost: sum |(L - mean L) - (R -
+/// mean R)|), winner-take-all, parabola sub-pixel refinement, left-right
+/// consistency check; confidence from the margin between the best and the
+/// second-best non-adjacent cost.
+class Nl1Matcher : public StereoMatcher {
+ public:
+  explicit Nl1Matcher(const Nl1Options& options = {});
+  DisparityMap Match(const cv::Mat& left, const cv::Mat& right, const cv::Mat& lo_px,
+                     const cv::Mat& hi_px) const override;
+  std::string Name() const override { return "nl1"; }
+
+ private:
+  Nl1Options options_;
+};
+
+}  // namespace fovea

@@ -1,0 +1,186 @@
+#include "fovea/foveal.h"
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+
+#include "fovea/geometry.h"
+
+namespace fovea {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double Since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// Full-resolution horizontal disparity of the point at planar depth z on the
+// left ray through (u, v).
+double DisparityAtDepth(const rig::CameraView& left, const rig::CameraView& right,
+                        const Eigen::Isometry3d& right_T_left, double u, double v, double z) {
+  const Eigen::Vector3d p_R = right_T_left * (z * left.intrinsics.Ray({u, v}));
+  if (p_R.z() <= 1e-6) return std::numeric_limits<double>::quiet_NaN();
+  const double ur = right.intrinsics.fx_px * p_R.x() / p_R.z() + right.intrinsics.cx_px;
+  return u - ur;
+}
+
+}  // namespace
+
+void FovealOptions::Check() const {
+  tessellation.Check();
+  if (fovea_patch_px < 3 || periphery_patch_px < 3) throw std::invalid_argument("foveal: patch sizes must be >= 3");
+  if (!(map_margin_px > 0) || !(coarse_margin_px > 0)) throw std::invalid_argument("foveal: margins must be positive");
+}
+
+void FixationOptions::Check() const {
+  vergence.Check();
+  servo.Check();
+  foveal.Check();
+  if (!(baseline_m > 0)) throw std::invalid_argument("fixation: baseline_m must be positive");
+}
+
+FovealResult FovealStereo(const rig::StereoFrame& frame, const Eigen::Vector3d& fixation_W,
+                          const PatchMap& map, const StereoMatcher& matcher,
+                          const FovealOptions& options, int fixation) {
+  options.Check();
+  const auto t_start = Clock::now();
+  FovealResult result;
+  const rig::CameraView& left = frame.left;
+  const rig::CameraView& right = frame.right;
+  const rig::CameraIntrinsics& k = left.intrinsics;
+  result.tessellation = Tessellate(left, right, fixation_W, map, options.tessellation);
+  const Tessellation& t = result.tessellation;
+  const Eigen::Isometry3d right_T_left = right.world_T_camera.inverse() * left.world_T_camera;
+  cv::Mat map_depth;
+  map.Render(left.world_T_camera, k, &map_depth, nullptr);
+  const double z0 = t.fixation_depth_m;
+
+  const int levels = static_cast<int>(t.rects.size());
+  result.disparity_px.resize(levels);
+  result.levels.resize(levels);
+  for (int level = levels - 1; level >= 0; --level) {
+    const auto t0 = Clock::now();
+    const double s = std::pow(2.0, level);
+    cv::Mat l, r;
+    if (level == 0) {
+      l = left.gray;
+      r = right.gray;
+    } else {
+      cv::resize(left.gray, l, cv::Size(), 1 / s, 1 / s, cv::INTER_AREA);
+      cv::resize(right.gray, r, cv::Size(), 1 / s, 1 / s, cv::INTER_AREA);
+    }
+    const cv::Rect& rect = t.rects[level];
+    cv::Mat lo(l.size(), CV_32F, cv::Scalar(1)), hi(l.size(), CV_32F, cv::Scalar(0));  // lo > hi: skip
+    const cv::Mat* coarse = level + 1 < levels ? &result.disparity_px[level + 1] : nullptr;
+    for (int y = 0; y < l.rows; ++y)
+      for (int x = 0; x < l.cols; ++x) {
+        const double u = (x + 0.5) * s - 0.5, v = (y + 0.5) * s - 0.5;
+        const int ui = std::clamp(static_cast<int>(std::lround(u)), 0, k.width_px - 1);
+        const int vi = std::clamp(static_cast<int>(std::lround(v)), 0, k.height_px - 1);
+        if (!rect.contains({ui, vi}) || t.mask.at<uchar>(vi, ui) == 0) continue;
+        double dlo, dhi;
+        const float cd = coarse ? coarse->at<float>(std::min(coarse->rows - 1, y / 2), std::min(coarse->cols - 1, x / 2))
+                                : std::numeric_limits<float>::quiet_NaN();
+        const float z = map_depth.at<float>(vi, ui);
+        if (std::isfinite(cd)) {
+          // The coarser level's estimate, in this level's pixels.
+          dlo = 2 * cd - options.coarse_margin_px;
+          dhi = 2 * cd + options.coarse_margin_px;
+        } else if (z > 0) {
+          const double d = DisparityAtDepth(left, right, right_T_left, u, v, z) / s;
+          dlo = d - options.map_margin_px;
+          dhi = d + options.map_margin_px;
+        } else {
+          // The map is silent: anything within Z_T of the fixation depth.
+          const double a = DisparityAtDepth(left, right, right_T_left, u, v, z0 - t.z_t_near_m) / s;
+          const double b = DisparityAtDepth(left, right, right_T_left, u, v, z0 + t.z_t_far_m) / s;
+          dlo = std::min(a, b) - 1;
+          dhi = std::max(a, b) + 1;
+        }
+        if (!std::isfinite(dlo) || !std::isfinite(dhi)) continue;
+        lo.at<float>(y, x) = static_cast<float>(dlo);
+        hi.at<float>(y, x) = static_cast<float>(dhi);
+      }
+    const DisparityMap dm = matcher.Match(l, r, lo, hi);
+    result.disparity_px[level] = dm.disparity_px;
+    LevelFigures& fig = result.levels[level];
+    fig.level = level;
+    fig.rect = rect;
+    fig.searched = dm.searched;
+    fig.matched = dm.matched;
+    fig.match_time_s = Since(t0);
+
+    // Patches over the part of the level not covered by the finer one.
+    const cv::Rect inner = level > 0 ? t.rects[level - 1] : cv::Rect();
+    const int size = level == 0 ? options.fovea_patch_px : options.periphery_patch_px;
+    for (int by = 0; by + size <= l.rows; by += size)
+      for (int bx = 0; bx + size <= l.cols; bx += size) {
+        const double cu = (bx + 0.5 * size) * s - 0.5, cv_ = (by + 0.5 * size) * s - 0.5;
+        if (!rect.contains({static_cast<int>(cu), static_cast<int>(cv_)})) continue;
+        if (level > 0 && inner.contains({static_cast<int>(cu), static_cast<int>(cv_)})) continue;
+        std::vector<DisparitySample> samples;
+        for (int y = by; y < by + size; ++y)
+          for (int x = bx; x < bx + size; ++x) {
+            const float d = dm.disparity_px.at<float>(y, x);
+            if (std::isfinite(d)) samples.push_back({double(x), double(y), d});
+          }
+        Eigen::Vector4d box;
+        const auto fit = FitDisparityPlane(samples, bx, by, size, options.plane_fit, &box);
+        if (!fit) continue;
+        const double ex0 = std::max(bx - 0.5, box(0) - 0.5), ey0 = std::max(by - 0.5, box(1) - 0.5);
+        const double ex1 = std::min(bx + size - 0.5, box(2) + 0.5), ey1 = std::min(by + size - 0.5, box(3) + 0.5);
+        if (ex1 - ex0 < 1 || ey1 - ey0 < 1) continue;
+        Patch p;
+        p.level = level == 0 ? PatchLevel::kFoveal : PatchLevel::kPeripheral;
+        p.resolution_level = level;
+        p.fixation = fixation;
+        p.fit_rms_px = fit->rms_px;
+        p.support = fit->support;
+        const double xs[4] = {ex0, ex1, ex1, ex0}, ys[4] = {ey0, ey0, ey1, ey1};
+        bool ok = true;
+        for (int c = 0; c < 4 && ok; ++c) {
+          const double d = (*fit)(xs[c], ys[c]) * s;
+          const double u = (xs[c] + 0.5) * s - 0.5, v = (ys[c] + 0.5) * s - 0.5;
+          const auto tri = TriangulateMidpoint(PixelRay(left.world_T_camera, k, {u, v}),
+                                               PixelRay(right.world_T_camera, right.intrinsics, {u - d, v}));
+          ok = tri.has_value();
+          if (ok) p.corners_W[c] = tri->p_W;
+        }
+        if (!ok) continue;
+        result.patches.Add(p);
+        ++fig.patches;
+      }
+  }
+  result.compute_time_s = Since(t_start);
+  return result;
+}
+
+FixationResult Fixate(rig::Rig& rig, const PatchMap& map, const Eigen::Vector3d& p_W,
+                      const StereoMatcher& matcher, const FixationOptions& options, int fixation) {
+  options.Check();
+  FixationResult r;
+  const auto t0 = Clock::now();
+  r.vergence = Verge(rig.Geometry(), rig.Limits(), rig.Intrinsics(rig::Side::kLeft),
+                     rig.Intrinsics(rig::Side::kRight), rig::StageState::Parallel(options.baseline_m), p_W,
+                     options.vergence);
+  if (!r.vergence.ok) {
+    r.why = r.vergence.why;
+    return r;
+  }
+  const double verge_s = Since(t0);
+  r.servo = Servo(rig, r.vergence.state, options.servo);
+  r.motion_time_s = r.servo.motion_time_s;
+  const rig::StereoFrame& frame = r.servo.frame;
+  // Where the two optical axes (the principal points' rays) meet.
+  const auto& kl = frame.left.intrinsics;
+  const auto& kr = frame.right.intrinsics;
+  const auto meet = TriangulateMidpoint(PixelRay(frame.left.world_T_camera, kl, {kl.cx_px, kl.cy_px}),
+                                        PixelRay(frame.right.world_T_camera, kr, {kr.cx_px, kr.cy_px}));
+  r.fixation_W = meet ? meet->p_W : p_W;
+  r.foveal = FovealStereo(frame, r.fixation_W, map, matcher, options.foveal, fixation);
+  r.compute_time_s = verge_s + r.foveal.compute_time_s;
+  r.ok = true;
+  return r;
+}
+
+}  // namespace fovea
