@@ -72,6 +72,20 @@ TEST_CASE("a user scene in any folder renders through the CLI", "[cli]") {
   fs::remove_all(out);
 }
 
+TEST_CASE("fovea bench fixation prints the figures scripts rely on", "[cli][slow]") {
+  const fs::path out = TempDir("bench");
+  fs::create_directories(out);
+  const std::string cmd = std::string(FOVEA_BIN) + " bench fixation --json > " + (out / "b.json").string() + " 2>/dev/null";
+  REQUIRE(std::system(cmd.c_str()) == 0);
+  std::ifstream in(out / "b.json");
+  std::string line;
+  std::getline(in, line);
+  for (const char* key : {"\"foveated_ms\"", "\"full_res_ms\"", "\"sgbm_ms\"", "\"foveal_error_px\"",
+                          "\"full_res_error_px\"", "\"sgbm_error_px\""})
+    CHECK(line.find(key) != std::string::npos);
+  fs::remove_all(out);
+}
+
 TEST_CASE("bad input gives one line on stderr, a non-zero exit and no output", "[cli]") {
   const fs::path out = TempDir("bad");
   const fs::path dir = TempDir("scenes");
@@ -99,6 +113,9 @@ TEST_CASE("bad input gives one line on stderr, a non-zero exit and no output", "
       {"render --scene " + intruder.path(), "rig's workspace"},
       {"render --scene " + driver.path(), "may not move the rig"},
       {"render --scene random:1:99", "N must be 1 to 30"},
+      {"fixate --point 0 0.9", "point"},
+      {"fixate --point 3 0.5 0", "cannot fixate"},
+      {"fixate --point 0 0.9 0 --matcher census", "matcher"},
   };
   for (const Case& c : cases) {
     const Result r = Fovea(c.args + " --out " + out.string());

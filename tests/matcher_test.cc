@@ -3,6 +3,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "fovea/matcher.h"
+#include "fovea/sgbm.h"
 
 namespace {
 cv::Mat Texture(int rows, int cols, uint64_t seed) {
@@ -78,4 +79,23 @@ TEST_CASE("NL1 matching: ranges bound the search, texture and left-right checks 
   const auto f = matcher.Match(flat, flat, wlo, whi);
   CHECK(f.matched == 0);
   CHECK(f.rejected_texture == f.searched);
+}
+
+TEST_CASE("SGBM plugs into the same interface and finds the same disparity", "[fovea][matcher]") {
+  const cv::Mat left = Texture(120, 200, 7);
+  const fovea::SgbmMatcher sgbm;
+  for (double d : {-5.0, 6.5}) {
+    INFO("disparity " << d);
+    const cv::Mat right = Shift(left, d);
+    const cv::Mat lo(left.size(), CV_32F, cv::Scalar(-10)), hi(left.size(), CV_32F, cv::Scalar(10));
+    const auto r = sgbm.Match(left, right, lo, hi);
+    std::vector<double> errs;
+    for (int y = 10; y < 110; ++y)
+      for (int x = 40; x < 160; ++x)
+        if (std::isfinite(r.disparity_px.at<float>(y, x))) errs.push_back(std::abs(r.disparity_px.at<float>(y, x) - d));
+    REQUIRE(errs.size() > 0.8 * 100 * 120);
+    std::nth_element(errs.begin(), errs.begin() + errs.size() / 2, errs.end());
+    CHECK(errs[errs.size() / 2] < 0.2);
+    CHECK(sgbm.Name() == "sgbm");
+  }
 }

@@ -4,6 +4,7 @@
 #include "commands.h"
 #include "foveal_eval.h"
 #include "fovea/idr.h"
+#include "fovea/sgbm.h"
 #include "output.h"
 #include "scene_options.h"
 
@@ -14,6 +15,7 @@ struct FixateArgs {
   SceneOptions scene;
   std::vector<double> point;
   std::string out;
+  std::string matcher = "nl1";
   fovea::FixationOptions fixation;
 };
 
@@ -23,8 +25,10 @@ int Fixate(const FixateArgs& args) {
   rig::Rig& rig = sim->rig();
   const fovea::IdrResult idr = fovea::RunIdr(rig, {});
   const Eigen::Vector3d p(args.point[0], args.point[1], args.point[2]);
-  const fovea::Nl1Matcher matcher;
-  const fovea::FixationResult r = fovea::Fixate(rig, idr.map, p, matcher, args.fixation);
+  std::unique_ptr<fovea::StereoMatcher> matcher;
+  if (args.matcher == "sgbm") matcher = std::make_unique<fovea::SgbmMatcher>();
+  else matcher = std::make_unique<fovea::Nl1Matcher>();
+  const fovea::FixationResult r = fovea::Fixate(rig, idr.map, p, *matcher, args.fixation);
   if (!r.ok) throw std::runtime_error("cannot fixate (" + std::to_string(p.x()) + ", " + std::to_string(p.y()) + ", " + std::to_string(p.z()) + "): " + r.why);
   const FovealScore score = ScoreFoveal(r, sim->truth());
   EnsureDirectory(args.out);
@@ -65,6 +69,7 @@ int Fixate(const FixateArgs& args) {
   nlohmann::json j = FixationJson(r, score);
   j["scene"] = sim->scene_path();
   j["point_W"] = args.point;
+  j["matcher"] = matcher->Name();
   WriteTextAtomic(args.out + "/fixate.json", j.dump(2) + "\n");
   std::fprintf(stderr, "fovea fixate: fovea %dx%d, %zu levels, %zu patches, foveal error %.3f steps, coverage %.3f -> %s\n",
                t.rects[0].width, t.rects[0].height, t.rects.size(), r.foveal.patches.size(),
@@ -82,6 +87,8 @@ void AddFixateCommand(CLI::App& app, std::function<int()>* run) {
   cmd->add_option("--point", args->point, "fixation point X Y Z in the world, metres")->required()->expected(3);
   cmd->add_option("--out", args->out, "output folder")->required();
   cmd->add_option("--baseline", args->fixation.baseline_m, "vergent baseline, metres")->capture_default_str();
+  cmd->add_option("--matcher", args->matcher, "per-level matcher: nl1 (the paper's cost) or sgbm")
+      ->check(CLI::IsMember({"nl1", "sgbm"}))->capture_default_str();
   cmd->callback([args, run] { *run = [args] { return Fixate(*args); }; });
 }
 
