@@ -93,6 +93,11 @@ TEST_CASE("bad input gives one line on stderr, a non-zero exit and no output", "
   std::ofstream(dir / "broken.xml") << "<mujoco><worldbody><geom type=\"box\"</worldbody>";
   std::ofstream(dir / "norig.xml") << "<mujoco><worldbody><geom size=\"1\"/></worldbody></mujoco>";
   std::ofstream(dir / "notxml.xml") << "hello";
+  std::ofstream(dir / "unknown.yaml") << "loop:\n  fixation: 3\n";
+  std::ofstream(dir / "type.yaml") << "loop:\n  fixations: many\n";
+  std::ofstream(dir / "range.yaml") << "foveal:\n  baseline_m: -0.1\n";
+  std::ofstream(dir / "zero.yaml") << "loop:\n  fixations: 0\n";
+  std::ofstream(dir / "bad.yaml") << "idr: [1, 2\n";
   const TempScene intruder("<geom type=\"box\" size=\"0.05 0.05 0.05\" pos=\"0 0.1 0\"/>");
   const TempScene driver("<geom type=\"box\" size=\"0.5 0.5 0.01\" pos=\"0 1 0\"/>", "",
                          "<actuator><motor joint=\"tavt_right_tilt\"/></actuator>");
@@ -116,6 +121,15 @@ TEST_CASE("bad input gives one line on stderr, a non-zero exit and no output", "
       {"fixate --point 0 0.9", "point"},
       {"fixate --point 3 0.5 0", "cannot fixate"},
       {"fixate --point 0 0.9 0 --matcher census", "matcher"},
+      {"run --config " + (dir / "unknown.yaml").string(), "unknown key 'loop.fixation'"},
+      {"run --config " + (dir / "type.yaml").string(), "key 'loop.fixations': expected a number"},
+      {"run --config " + (dir / "range.yaml").string(), "key 'foveal.baseline_m': -0.1 is out of range"},
+      {"run --config " + (dir / "zero.yaml").string(), "key 'loop.fixations': 0 is out of range [1, 10000]"},
+      {"run --config " + (dir / "bad.yaml").string(), "not valid YAML"},
+      {"run --config /nonexistent/run.yaml", "cannot read"},
+      {"run --scene no_such_scene", "unknown scene"},
+      {"run --set matcher=census", "key 'matcher'"},
+      {"run --set selection.deterministic=maybe", "expected true or false"},
   };
   for (const Case& c : cases) {
     const Result r = Fovea(c.args + " --out " + out.string());

@@ -13,5 +13,6 @@ void AddBenchCommand(CLI::App& app, std::function<int()>* run);
 void AddCatalogCommands(CLI::App& app, std::function<int()>* run);
 void AddIdrCommand(CLI::App& app, std::function<int()>* run);
 void AddFixateCommand(CLI::App& app, std::function<int()>* run);
+void AddRunCommand(CLI::App& app, std::function<int()>* run);
 
 }  // namespace experiments

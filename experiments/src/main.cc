@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
   experiments::AddCatalogCommands(app, &run);
   experiments::AddIdrCommand(app, &run);
   experiments::AddFixateCommand(app, &run);
+  experiments::AddRunCommand(app, &run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -112,7 +112,18 @@ FovealResult FovealStereo(const rig::StereoFrame& frame, const Eigen::Vector3d& 
 
     // Patches over the part of the level not covered by the finer one.
     const cv::Rect inner = level > 0 ? t.rects[level - 1] : cv::Rect();
-    const int size = level == 0 ? options.fovea_patch_px : options.periphery_patch_px;
+    // Peripheral patches keep about the same size in the image at every
+    // level (the paper's were about twice the foveal ones), but never fewer
+    // than 4 x 4 of the level's pixels; their fit tolerance shrinks with the
+    // level so that it stays near a full-resolution pixel and a plane cannot
+    // bridge a depth step.
+    const int size = level == 0 ? options.fovea_patch_px
+                                : std::max(4, options.periphery_patch_px >> level);
+    PlaneFitOptions fit_options = options.plane_fit;
+    if (level > 0) {
+      fit_options.fit_tolerance_px = std::max(0.25, options.plane_fit.fit_tolerance_px / s);
+      fit_options.min_support = std::min(options.plane_fit.min_support, (3 * size * size) / 4);
+    }
     for (int by = 0; by + size <= l.rows; by += size)
       for (int bx = 0; bx + size <= l.cols; bx += size) {
         const double cu = (bx + 0.5 * size) * s - 0.5, cv_ = (by + 0.5 * size) * s - 0.5;
@@ -125,7 +136,7 @@ FovealResult FovealStereo(const rig::StereoFrame& frame, const Eigen::Vector3d& 
             if (std::isfinite(d)) samples.push_back({double(x), double(y), d});
           }
         Eigen::Vector4d box;
-        const auto fit = FitDisparityPlane(samples, bx, by, size, options.plane_fit, &box);
+        const auto fit = FitDisparityPlane(samples, bx, by, size, fit_options, &box);
         if (!fit) continue;
         const double ex0 = std::max(bx - 0.5, box(0) - 0.5), ey0 = std::max(by - 0.5, box(1) - 0.5);
         const double ex1 = std::min(bx + size - 0.5, box(2) + 0.5), ey1 = std::min(by + size - 0.5, box(3) + 0.5);
@@ -168,7 +179,10 @@ FixationResult Fixate(rig::Rig& rig, const PatchMap& map, const Eigen::Vector3d&
     return r;
   }
   const double verge_s = Since(t0);
+  r.verge_time_s = verge_s;
+  const auto t_servo = Clock::now();
   r.servo = Servo(rig, r.vergence.state, options.servo);
+  r.servo_wall_s = Since(t_servo);
   r.motion_time_s = r.servo.motion_time_s;
   const rig::StereoFrame& frame = r.servo.frame;
   // Where the two optical axes (the principal points' rays) meet.

@@ -1,6 +1,7 @@
 #include "fovea/patch.h"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -103,18 +104,166 @@ double RayTriangle(const Eigen::Vector3d& o, const Eigen::Vector3d& d, const Eig
 }
 }  // namespace
 
+void PatchMap::Add(const Patch& patch) {
+  patches_.push_back(patch);
+  index_valid_ = false;
+}
+
+void PatchMap::Append(const PatchMap& other) {
+  patches_.insert(patches_.end(), other.patches_.begin(), other.patches_.end());
+  index_valid_ = false;
+}
+
+void PatchMap::Clear() {
+  patches_.clear();
+  index_valid_ = false;
+}
+
+size_t PatchMap::Remove(const std::vector<char>& drop) {
+  size_t kept = 0;
+  for (size_t i = 0; i < patches_.size(); ++i)
+    if (i >= drop.size() || !drop[i]) patches_[kept++] = patches_[i];
+  const size_t removed = patches_.size() - kept;
+  patches_.resize(kept);
+  if (removed) index_valid_ = false;
+  return removed;
+}
+
+std::array<int, 3> PatchMap::CountByLevel() const {
+  std::array<int, 3> n{0, 0, 0};
+  for (const Patch& p : patches_) ++n[static_cast<int>(p.level)];
+  return n;
+}
+
+namespace {
+constexpr int kLeafSize = 4;
+
+// Nearest hit of the ray on a patch's two triangles, or +infinity.
+double RayPatch(const Eigen::Vector3d& o, const Eigen::Vector3d& d, const Patch& p) {
+  double best = std::numeric_limits<double>::infinity();
+  const auto& c = p.corners_W;
+  for (const auto& tri : {std::array<int, 3>{0, 1, 2}, std::array<int, 3>{0, 2, 3}}) {
+    const double t = RayTriangle(o, d, c[tri[0]], c[tri[1]], c[tri[2]]);
+    if (t > 0 && t < best) best = t;
+  }
+  return best;
+}
+
+// Entry distance of the ray into the box (slab test), or +infinity if missed.
+double RayBox(const Eigen::Vector3d& o, const Eigen::Vector3d& inv_d, const Eigen::AlignedBox3d& b) {
+  double t0 = 0, t1 = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < 3; ++a) {
+    double ta = (b.min()(a) - o(a)) * inv_d(a), tb = (b.max()(a) - o(a)) * inv_d(a);
+    if (std::isnan(ta) || std::isnan(tb)) {  // ray parallel to the slab, origin on its plane
+      if (o(a) < b.min()(a) || o(a) > b.max()(a)) return std::numeric_limits<double>::infinity();
+      continue;
+    }
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+    if (t0 > t1) return std::numeric_limits<double>::infinity();
+  }
+  return t0;
+}
+}  // namespace
+
+int PatchMap::BuildNode(int first, int count, std::vector<Eigen::AlignedBox3d>* boxes,
+                        std::vector<Eigen::Vector3d>* centres) const {
+  Node node;
+  Eigen::AlignedBox3d centre_box;
+  for (int i = first; i < first + count; ++i) {
+    node.box.extend((*boxes)[order_[i]]);
+    centre_box.extend((*centres)[order_[i]]);
+  }
+  const int id = static_cast<int>(nodes_.size());
+  nodes_.push_back(node);
+  if (count <= kLeafSize) {
+    nodes_[id].first = first;
+    nodes_[id].count = count;
+    return id;
+  }
+  // Median split along the widest axis of the centres.
+  int axis;
+  centre_box.sizes().maxCoeff(&axis);
+  const int mid = first + count / 2;
+  std::nth_element(order_.begin() + first, order_.begin() + mid, order_.begin() + first + count,
+                   [&](int a, int b) { return (*centres)[a](axis) < (*centres)[b](axis); });
+  const int left = BuildNode(first, mid - first, boxes, centres);
+  const int right = BuildNode(mid, first + count - mid, boxes, centres);
+  nodes_[id].left = left;
+  nodes_[id].right = right;
+  return id;
+}
+
+void PatchMap::BuildIndex() const {
+  if (index_valid_) return;
+  nodes_.clear();
+  order_.resize(patches_.size());
+  std::vector<Eigen::AlignedBox3d> boxes(patches_.size());
+  std::vector<Eigen::Vector3d> centres(patches_.size());
+  for (size_t i = 0; i < patches_.size(); ++i) {
+    order_[i] = static_cast<int>(i);
+    for (const auto& c : patches_[i].corners_W) boxes[i].extend(c);
+    centres[i] = boxes[i].center();
+  }
+  if (!patches_.empty()) {
+    nodes_.reserve(2 * patches_.size() / kLeafSize + 2);
+    BuildNode(0, static_cast<int>(patches_.size()), &boxes, &centres);
+  }
+  index_valid_ = true;
+}
+
 std::optional<PatchHit> PatchMap::CastRay(const Eigen::Vector3d& origin_W,
                                           const Eigen::Vector3d& direction_W) const {
+  BuildIndex();
+  if (nodes_.empty()) return std::nullopt;
+  const Eigen::Vector3d inv_d = direction_W.cwiseInverse();
+  PatchHit best;
+  best.distance_m = std::numeric_limits<double>::infinity();
+  // Depth-first, nearer child first, pruning boxes entered beyond the best hit.
+  std::vector<std::pair<double, int>> stack;
+  stack.reserve(64);
+  const double t_root = RayBox(origin_W, inv_d, nodes_[0].box);
+  if (std::isfinite(t_root)) stack.emplace_back(t_root, 0);
+  while (!stack.empty()) {
+    const auto [t_enter, id] = stack.back();
+    stack.pop_back();
+    if (t_enter >= best.distance_m) continue;
+    const Node& n = nodes_[id];
+    if (n.left < 0) {
+      for (int i = n.first; i < n.first + n.count; ++i) {
+        const double t = RayPatch(origin_W, direction_W, patches_[order_[i]]);
+        if (t < best.distance_m || (t == best.distance_m && order_[i] < best.patch)) {
+          best.distance_m = t;
+          best.patch = order_[i];
+        }
+      }
+      continue;
+    }
+    const double tl = RayBox(origin_W, inv_d, nodes_[n.left].box);
+    const double tr = RayBox(origin_W, inv_d, nodes_[n.right].box);
+    // Push the farther first so that the nearer is visited first.
+    if (tl <= tr) {
+      if (std::isfinite(tr)) stack.emplace_back(tr, n.right);
+      if (std::isfinite(tl)) stack.emplace_back(tl, n.left);
+    } else {
+      if (std::isfinite(tl)) stack.emplace_back(tl, n.left);
+      if (std::isfinite(tr)) stack.emplace_back(tr, n.right);
+    }
+  }
+  if (best.patch < 0) return std::nullopt;
+  return best;
+}
+
+std::optional<PatchHit> PatchMap::CastRayBruteForce(const Eigen::Vector3d& origin_W,
+                                                    const Eigen::Vector3d& direction_W) const {
   PatchHit best;
   best.distance_m = std::numeric_limits<double>::infinity();
   for (size_t i = 0; i < patches_.size(); ++i) {
-    const auto& c = patches_[i].corners_W;
-    for (const auto& tri : {std::array<int, 3>{0, 1, 2}, std::array<int, 3>{0, 2, 3}}) {
-      const double t = RayTriangle(origin_W, direction_W, c[tri[0]], c[tri[1]], c[tri[2]]);
-      if (t > 0 && t < best.distance_m) {
-        best.distance_m = t;
-        best.patch = static_cast<int>(i);
-      }
+    const double t = RayPatch(origin_W, direction_W, patches_[i]);
+    if (t < best.distance_m) {
+      best.distance_m = t;
+      best.patch = static_cast<int>(i);
     }
   }
   if (best.patch < 0) return std::nullopt;
@@ -160,9 +309,16 @@ void PatchMap::Render(const Eigen::Isometry3d& world_T_camera,
           if (w0 < -1e-9 || w1 < -1e-9 || w2 < -1e-9) continue;
           const double z = 1.0 / (w0 * inv_z[0] + w1 * inv_z[1] + w2 * inv_z[2]);
           float& d = depth.at<float>(v, u);
-          if (d == 0 || z < d) {
+          int& id = ids.at<int>(v, u);
+          bool take = d == 0 || z < d;
+          if (d != 0 && std::abs(z - d) <= kSameSurfaceShare * d) {
+            // The same surface seen twice: the finer level wins.
+            const int mine = patches_[i].Fineness(), theirs = patches_[id].Fineness();
+            take = mine > theirs || (mine == theirs && z < d);
+          }
+          if (take) {
             d = static_cast<float>(z);
-            ids.at<int>(v, u) = static_cast<int>(i);
+            id = static_cast<int>(i);
           }
         }
       }

@@ -20,7 +20,9 @@ namespace fovea {
 struct FovealOptions {
   TessellationOptions tessellation;
   int fovea_patch_px = 8;       ///< patch size at level 0, in its pixels
-  int periphery_patch_px = 16;  ///< patch size at coarser levels, in their pixels
+  /// Patch size at coarser levels in full-resolution pixels: level k uses
+  /// blocks of max(4, periphery_patch_px / 2^k) of its pixels.
+  int periphery_patch_px = 32;
   PlaneFitOptions plane_fit{/*min_support=*/12, /*fit_tolerance_px=*/1.0, /*min_inlier_share=*/0.8,
                             /*require_quadrants=*/true};
   double map_margin_px = 2.0;   ///< search +- this many level pixels around the map's prediction
@@ -68,6 +70,8 @@ struct FixationResult {
   Eigen::Vector3d fixation_W = Eigen::Vector3d::Zero();  ///< where the optical axes meet after servoing
   FovealResult foveal;
   double motion_time_s = 0, compute_time_s = 0;
+  double verge_time_s = 0;  ///< inverse kinematics
+  double servo_wall_s = 0;  ///< the servo loop: moves, captures and measurements, wall clock
 };
 
 /// Verges on p_W, servos, captures and runs the foveated stereo.

@@ -26,6 +26,10 @@ struct Patch {
   double fit_rms_px = 0;      ///< RMS residual of its disparity-plane fit
   int support = 0;            ///< number of measurements in the fit
 
+  /// Order of precedence between patches of the same surface: foveal over
+  /// peripheral over IDR, and within a level the finer resolution first.
+  int Fineness() const { return 8 * static_cast<int>(level) - resolution_level; }
+
   Eigen::Vector3d Centre() const;
   /// Unit normal (right-handed from the corner order).
   Eigen::Vector3d Normal() const;
@@ -76,24 +80,66 @@ struct PatchHit {
 
 /// The global map of patches. Queries: by ray (raytrace a pixel of any camera
 /// into the map) and by footprint in a view (rasterize the map into a camera).
+///
+/// Spatial index: a bounding-volume hierarchy over the patches' boxes, built
+/// lazily by the first query after a change, in O(N log N) for N patches.
+/// A ray query then visits O(log N) nodes on typical (spread-out) maps
+/// instead of testing every patch; the map changes in batches (one per
+/// fixation), so the index is rebuilt once per batch. Rendering is
+/// O(N + pixels covered). Const queries rebuild the index if needed, so a map
+/// that has changed must not be queried from several threads at once; call
+/// BuildIndex() first to share it.
 class PatchMap {
  public:
   const std::vector<Patch>& patches() const { return patches_; }
   size_t size() const { return patches_.size(); }
-  void Add(const Patch& patch) { patches_.push_back(patch); }
-  void Clear() { patches_.clear(); }
+  bool empty() const { return patches_.empty(); }
+  const Patch& operator[](size_t i) const { return patches_[i]; }
+  void Add(const Patch& patch);
+  void Append(const PatchMap& other);
+  void Clear();
+  /// Removes the patches whose flag is set (`drop` has one flag per patch);
+  /// the others keep their order. Returns how many were removed.
+  size_t Remove(const std::vector<char>& drop);
+  /// Number of patches per PatchLevel (indexed by the enum's value).
+  std::array<int, 3> CountByLevel() const;
 
   /// First patch hit by the ray from origin_W along direction_W (unit).
   std::optional<PatchHit> CastRay(const Eigen::Vector3d& origin_W, const Eigen::Vector3d& direction_W) const;
+  /// The same query by testing every patch: the reference for the index.
+  std::optional<PatchHit> CastRayBruteForce(const Eigen::Vector3d& origin_W,
+                                            const Eigen::Vector3d& direction_W) const;
+
+  /// Depths within this share of each other at a pixel are the same surface.
+  static constexpr double kSameSurfaceShare = 0.02;
 
   /// The map seen by a camera: planar depth (CV_32F, 0 where no patch) and
-  /// the index of the nearest patch per pixel (CV_32S, -1 where none), by
-  /// z-buffered rasterization of every patch in front of the camera.
+  /// the index of the patch seen per pixel (CV_32S, -1 where none), by
+  /// z-buffered rasterization of every patch in front of the camera. Where
+  /// patches lie within kSameSurfaceShare of depth of each other, the one of
+  /// the finest level is seen (finer data supersedes coarser), else the
+  /// nearest.
   void Render(const Eigen::Isometry3d& world_T_camera, const rig::CameraIntrinsics& intrinsics,
               cv::Mat* depth_m, cv::Mat* patch_ids) const;
 
+  /// Builds the index now if the map changed since it was last built.
+  void BuildIndex() const;
+  /// Nodes of the index (0 before it is built); for tests and figures.
+  size_t IndexNodes() const { return nodes_.size(); }
+
  private:
+  struct Node {
+    Eigen::AlignedBox3d box;
+    int left = -1, right = -1;  ///< children (inner node) or -1 (leaf)
+    int first = 0, count = 0;   ///< leaf: range in order_
+  };
+  int BuildNode(int first, int count, std::vector<Eigen::AlignedBox3d>* boxes,
+                std::vector<Eigen::Vector3d>* centres) const;
+
   std::vector<Patch> patches_;
+  mutable std::vector<Node> nodes_;
+  mutable std::vector<int> order_;
+  mutable bool index_valid_ = false;
 };
 
 }  // namespace fovea

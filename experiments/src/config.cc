@@ -1,0 +1,195 @@
+#include "config.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "output.h"
+
+namespace experiments {
+namespace {
+
+std::string FormatNumber(double v) {
+  char buf[64];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
+}
+
+std::string Range(const ConfigParam& p) {
+  if (std::holds_alternative<bool*>(p.target)) return "true or false";
+  if (std::holds_alternative<std::string*>(p.target)) {
+    if (p.choices.empty()) return "any text";
+    std::string s = "one of";
+    for (size_t i = 0; i < p.choices.size(); ++i) s += (i ? ", " : " ") + p.choices[i];
+    return s;
+  }
+  return "[" + FormatNumber(p.lo) + ", " + FormatNumber(p.hi) + "]";
+}
+
+// Parses `text` as a whole number of the given kind, or fails.
+bool ParseDouble(const std::string& text, double* v) {
+  const char* b = text.data();
+  const auto r = std::from_chars(b, b + text.size(), *v);
+  return r.ec == std::errc() && r.ptr == b + text.size() && std::isfinite(*v);
+}
+
+void Assign(const ConfigParam& p, const std::string& text, const std::string& where) {
+  auto fail = [&](const std::string& why) { throw UsageError(where + "key '" + p.path + "': " + why); };
+  if (auto* b = std::get_if<bool*>(&p.target)) {
+    if (text == "true") **b = true;
+    else if (text == "false") **b = false;
+    else fail("expected true or false, got '" + text + "'");
+    return;
+  }
+  if (auto* s = std::get_if<std::string*>(&p.target)) {
+    if (!p.choices.empty() && std::find(p.choices.begin(), p.choices.end(), text) == p.choices.end())
+      fail("'" + text + "' is not " + Range(p));
+    **s = text;
+    return;
+  }
+  double v;
+  if (!ParseDouble(text, &v)) fail("expected a number, got '" + text + "'");
+  const bool integral = !std::holds_alternative<double*>(p.target);
+  if (integral && v != std::floor(v)) fail("expected a whole number, got '" + text + "'");
+  if (v < p.lo || v > p.hi) fail(text + " is out of range " + Range(p));
+  if (auto* d = std::get_if<double*>(&p.target)) **d = v;
+  else if (auto* i = std::get_if<int*>(&p.target)) **i = static_cast<int>(v);
+  else if (auto* u = std::get_if<uint64_t*>(&p.target)) **u = static_cast<uint64_t>(v);
+}
+
+std::string ValueText(const ConfigParam& p) {
+  if (auto* b = std::get_if<bool*>(&p.target)) return **b ? "true" : "false";
+  if (auto* s = std::get_if<std::string*>(&p.target)) return (*s)->empty() ? "\"\"" : **s;
+  if (auto* d = std::get_if<double*>(&p.target)) return FormatNumber(**d);
+  if (auto* i = std::get_if<int*>(&p.target)) return std::to_string(**i);
+  return std::to_string(**std::get_if<uint64_t*>(&p.target));
+}
+
+}  // namespace
+
+std::vector<ConfigParam> ConfigParams(RunConfig* c) {
+  fovea::FoveaOptions& f = c->fovea;
+  constexpr double kBig = 1e9;
+  return {
+      {"scene", "catalog scene name or path to an MJCF scene file (empty: cylinder_planes)", &c->scene},
+      {"seed", "the one seed: sensor noise and every fixation draw", &c->seed, 0, 9007199254740992.0},
+      {"matcher", "matcher of the foveated stage", &c->matcher, 0, 0, {"nl1", "sgbm"}},
+      {"rig.noise_sigma_dn", "sensor read noise, grey levels (0 = off)", &c->noise_sigma_dn, 0, 50},
+      {"loop.fixations", "successful fixations to make", &f.fixations, 1, 10000},
+      {"loop.stay_in_idr_view", "fixate only points inside the IDR view (the region the run maps)", &f.stay_in_idr_view},
+      {"loop.stall_fixations", "stop when the foveal share grew by less than stall_growth over this many fixations (0 = never)", &f.stall_fixations, 0, 10000},
+      {"loop.stall_growth", "see stall_fixations (share of the IDR view)", &f.stall_growth, 0, 1},
+      {"loop.attempts_per_fixation", "attempt budget per fixation wanted (points that cannot be fixated)", &f.attempts_per_fixation, 1, 100},
+      {"idr.log_sigma_px", "LoG scale of the zero crossings, pixels", &f.idr.zero_crossings.sigma_px, 1, 8},
+      {"idr.unique_share", "share of zero crossings kept unambiguous at the initial baseline", &f.idr.unique_share, 0.5, 1},
+      {"idr.z_min_m", "nearest scene distance, metres", &f.idr.z_min_m, 0.05, 10},
+      {"idr.max_slant_deg", "largest surface slant for the expansion factor, degrees", &f.idr.max_slant_deg, 0, 89},
+      {"idr.max_expansion", "cap on the baseline expansion factor per stage", &f.idr.max_expansion, 1.1, 16},
+      {"idr.vergent_search_px", "P: the vergent stage resolves +-P px (IDR termination)", &f.idr.vergent_search_px, 0.5, 64},
+      {"idr.max_stages", "baseline stage budget", &f.idr.max_stages, 1, 20},
+      {"idr.patch_size_px", "IDR patch size, pixels", &f.idr.patch_size_px, 4, 128},
+      {"foveal.baseline_m", "vergent baseline, metres", &f.fixation.baseline_m, 0.001, 0.6},
+      {"foveal.horizontal_disparity_limit_px", "the fovea's horizontal disparity limit (sets Z_T), pixels", &f.fixation.foveal.tessellation.horizontal_disparity_limit_px, 2, 256},
+      {"foveal.max_levels", "resolution levels of the tessellation", &f.fixation.foveal.tessellation.max_levels, 1, 6},
+      {"foveal.fovea_patch_px", "patch size at full resolution, pixels", &f.fixation.foveal.fovea_patch_px, 4, 64},
+      {"foveal.periphery_patch_px", "patch size at coarser levels, full-resolution pixels (at least 4 pixels of the level)", &f.fixation.foveal.periphery_patch_px, 4, 64},
+      {"foveal.servo_tolerance_px", "servoing stops below this centre disparity, pixels", &f.fixation.servo.tolerance_px, 0.01, 10},
+      {"foveal.servo_max_steps", "servoing step budget", &f.fixation.servo.max_steps, 0, 50},
+      {"selection.deterministic", "always fixate the composite's maximum instead of drawing", &f.selection.deterministic},
+      {"selection.draw_scale", "scale s of the exponential draw", &f.selection.draw_scale, 0.001, 100},
+      {"selection.histogram_bins", "bins of the composite's histogram", &f.selection.histogram_bins, 2, 4096},
+      {"selection.border_px", "fixation candidates keep this far from the image edge, pixels", &f.selection.border_px, 0, 200},
+      {"selection.refused_radius_m", "candidates this close to a point that could not be fixated are left out, metres", &f.selection.refused_radius_m, 0, 1},
+      {"criteria.gradient", "use gradient attraction", &f.criteria.gradient},
+      {"criteria.suppression", "use local suppression", &f.criteria.suppression},
+      {"criteria.proximity_2d", "use 2D proximity", &f.criteria.proximity_2d},
+      {"criteria.proximity_3d", "use 3D proximity", &f.criteria.proximity_3d},
+      {"criteria.gradient_blur_px", "gradient attraction's smoothing scale, pixels", &f.criteria.gradient_blur_px, 0.1, 50},
+      {"criteria.suppressed_weight", "local suppression's weight where the map is foveal (1 elsewhere)", &f.criteria.suppressed_weight, 0, 1},
+      {"criteria.suppression_radius_m", "local suppression also covers this distance around earlier fixation points, metres", &f.criteria.suppression_radius_m, 0, 1},
+      {"criteria.proximity_2d_scale_px", "2D proximity's scale s in exp(-r / s), pixels", &f.criteria.proximity_2d_scale_px, 1, kBig},
+      {"criteria.proximity_3d_low", "3D proximity's weight outside the Z_T band (1 inside)", &f.criteria.proximity_3d_low, 0, 1},
+      {"integration.overlap_share", "overlap share at which new patches replace old ones (and finer data blocks new ones)", &f.integration.overlap_share, 0.01, 1},
+  };
+}
+
+void SetParam(RunConfig* config, const std::string& path, const std::string& value) {
+  for (const ConfigParam& p : ConfigParams(config))
+    if (p.path == path) return Assign(p, value, "");
+  throw UsageError("unknown key '" + path + "'");
+}
+
+namespace {
+void Walk(const YAML::Node& node, const std::string& prefix, std::map<std::string, const ConfigParam*>& params,
+          const std::string& where) {
+  for (const auto& kv : node) {
+    const std::string key = kv.first.as<std::string>();
+    const std::string path = prefix.empty() ? key : prefix + "." + key;
+    const auto it = params.find(path);
+    if (kv.second.IsMap()) {
+      if (it != params.end()) throw UsageError(where + "key '" + path + "': expected a value, got a mapping");
+      bool known_section = false;
+      for (const auto& [name, p] : params) known_section |= name.rfind(path + ".", 0) == 0;
+      if (!known_section) throw UsageError(where + "unknown key '" + path + "'");
+      Walk(kv.second, path, params, where);
+      continue;
+    }
+    if (it == params.end()) throw UsageError(where + "unknown key '" + path + "'");
+    if (!kv.second.IsScalar()) throw UsageError(where + "key '" + path + "': expected a single value");
+    Assign(*it->second, kv.second.Scalar(), where);
+  }
+}
+}  // namespace
+
+RunConfig LoadConfig(const std::string& path) {
+  const std::string where = "config " + path + ": ";
+  std::ifstream in(path);
+  if (!in) throw UsageError(where + "cannot read the file");
+  std::stringstream text;
+  text << in.rdbuf();
+  YAML::Node root;
+  try {
+    root = YAML::Load(text.str());
+  } catch (const YAML::Exception& e) {
+    throw UsageError(where + "not valid YAML (line " + std::to_string(e.mark.line + 1) + ": " + e.msg + ")");
+  }
+  RunConfig config;
+  if (root.IsNull()) return config;
+  if (!root.IsMap()) throw UsageError(where + "expected a mapping of keys at the top level");
+  const std::vector<ConfigParam> params = ConfigParams(&config);
+  std::map<std::string, const ConfigParam*> by_path;
+  for (const ConfigParam& p : params) by_path[p.path] = &p;
+  Walk(root, "", by_path, where);
+  try {
+    config.fovea.Check();
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(where + e.what());
+  }
+  return config;
+}
+
+std::string DumpConfig(const RunConfig& const_config) {
+  RunConfig config = const_config;
+  std::ostringstream out;
+  out << "# FOVEA run configuration: every parameter, with its meaning and range.\n";
+  std::string section;
+  for (const ConfigParam& p : ConfigParams(&config)) {
+    const size_t dot = p.path.find('.');
+    const std::string sec = dot == std::string::npos ? "" : p.path.substr(0, dot);
+    const std::string key = dot == std::string::npos ? p.path : p.path.substr(dot + 1);
+    if (sec != section) {
+      out << sec << ":\n";
+      section = sec;
+    }
+    const std::string indent = sec.empty() ? "" : "  ";
+    out << indent << key << ": " << ValueText(p) << "  # " << p.doc << "; " << Range(p) << "\n";
+  }
+  return out.str();
+}
+
+}  // namespace experiments

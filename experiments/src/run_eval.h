@@ -1,0 +1,62 @@
+// Ground-truth scoring of the global map (design note "Ground truth and
+// scoring"): the map raytraced into the reference view (the left camera at
+// the rig's home pose) against the true depth there.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "fovea/patch.h"
+#include "rig/rig.h"
+#include "sim/ground_truth.h"
+
+namespace experiments {
+
+/// The reference view and its truth.
+struct ReferenceView {
+  rig::CameraView view;   ///< left camera at home: image, pose, intrinsics
+  cv::Mat depth_m;        ///< true planar depth (CV_32F, 0 = nothing)
+  cv::Mat geom_ids;       ///< surface per pixel (CV_32S, -1 = nothing)
+  cv::Mat textured;       ///< CV_8U, 255 where a textured surface is visible
+  long textured_pixels = 0;
+};
+
+/// Moves the rig home and captures the left camera there.
+ReferenceView MakeReferenceView(rig::Rig& rig, const sim::GroundTruth& truth);
+
+struct ErrorFigures {
+  long pixels = 0;                 ///< mapped textured pixels scored
+  double share = 0;                ///< of the visible textured pixels
+  double median_abs_error_m = 0, mean_abs_error_m = 0, rmse_m = 0;
+  double median_rel_error = 0;     ///< |Z - Z_true| / Z_true
+  double within_1pct = 0;          ///< share of scored pixels within 1% of depth
+  double median_error_steps = 0;   ///< in disparity steps Z^2 / (f B) at the vergent baseline
+};
+
+struct SurfaceFigures {
+  std::string name;
+  long pixels = 0;                 ///< visible textured pixels of the surface
+  double coverage = 0, foveal_coverage = 0, median_abs_error_m = 0;
+};
+
+struct MapScore {
+  double coverage = 0;             ///< share of visible textured pixels with an estimate
+  double foveal_coverage = 0;      ///< ... with a foveal estimate
+  ErrorFigures overall;
+  std::array<ErrorFigures, 3> by_level;  ///< by PatchLevel of the patch seen
+  std::vector<SurfaceFigures> surfaces;
+  /// Per-patch 3D distance from the patch centre to the true surface (along
+  /// the patch normal, by ray casting), when asked for.
+  bool has_patch_error = false;
+  double patch_error_median_m = 0, patch_error_p90_m = 0;
+  int patches_scored = 0;
+};
+
+/// Scores `map` in the reference view; `baseline_m` sets the disparity step.
+MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref, const sim::GroundTruth& truth,
+                  double baseline_m, bool per_patch);
+
+nlohmann::json ScoreJson(const MapScore& score);
+
+}  // namespace experiments

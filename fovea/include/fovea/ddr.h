@@ -1,0 +1,104 @@
+// The full FOVEA loop (paper section IV; design note "DDR"): IDR, then
+// fixation after fixation: choose, verge, servo, tessellate, match, patch,
+// integrate, record.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "fovea/foveal.h"
+#include "fovea/idr.h"
+#include "fovea/integration.h"
+#include "fovea/selection.h"
+#include "rig/rig.h"
+
+namespace fovea {
+
+/// Which criteria the selector multiplies (all on: the paper's rule).
+struct CriteriaOptions {
+  bool gradient = true;
+  bool suppression = true;
+  bool proximity_2d = true;
+  bool proximity_3d = true;
+  double gradient_blur_px = 2.0;
+  double suppressed_weight = 0.02;  ///< local suppression's weight on foveal data
+  double suppression_radius_m = 0.04;  ///< and within this distance of an earlier fixation
+  double proximity_2d_scale_px = 160;
+  double proximity_3d_low = 0.1;    ///< 3D proximity's weight outside the Z_T band
+  void Check() const;
+  std::vector<std::shared_ptr<const FixationCriterion>> Make() const;
+};
+
+struct FoveaOptions {
+  IdrOptions idr;
+  FixationOptions fixation;
+  SelectionOptions selection;
+  CriteriaOptions criteria;
+  IntegrationOptions integration;
+  int fixations = 25;          ///< successful fixations to make
+  /// Fixate only points inside the IDR view: the region the run maps.
+  bool stay_in_idr_view = true;
+  /// Stop early when the map's foveal share of the IDR view grew by less
+  /// than `stall_growth` over this many fixations in a row (0 = never).
+  int stall_fixations = 0;
+  double stall_growth = 0.002;
+  /// Attempts allowed per fixation wanted, so that a run of refused points
+  /// always ends.
+  int attempts_per_fixation = 3;
+  uint64_t seed = 0;           ///< the one generator's seed
+  void Check() const;          ///< throws std::invalid_argument naming the field
+};
+
+/// Wall-clock seconds by stage of one fixation.
+struct StageTimes {
+  double select_s = 0, verge_s = 0, servo_s = 0, foveal_s = 0, match_s = 0, integrate_s = 0;
+  double ComputeS() const { return select_s + verge_s + foveal_s + integrate_s; }
+};
+
+/// Everything one attempt did, for the records.
+struct FixationRecord {
+  int attempt = 0;                 ///< 1-based
+  int fixation = 0;                ///< 1-based index among successful ones (0 if refused)
+  bool ok = false;
+  std::string why;                 ///< when refused
+  SelectionSummary selection;      ///< how the target was chosen (first one: from IDR)
+  Eigen::Vector3d target_W = Eigen::Vector3d::Zero();
+  Eigen::Vector3d fixation_W = Eigen::Vector3d::Zero();
+  rig::StageState state;
+  int servo_iterations = 0;
+  double servo_residual_px = 0;
+  bool servo_converged = false;
+  Tessellation tessellation;       ///< without its images (cleared)
+  std::vector<LevelFigures> levels;
+  IntegrationStats integration;
+  std::array<int, 3> map_by_level{0, 0, 0};
+  double foveal_share = 0;         ///< map's foveal share of the IDR view, as the loop sees it
+  double motion_time_s = 0;
+  StageTimes time;
+};
+
+struct FoveaRun {
+  IdrResult idr;
+  PatchMap map;
+  std::vector<FixationRecord> records;
+  int fixations_done = 0;
+  std::string stop_reason;
+  double motion_time_s = 0;        ///< IDR's and every fixation's
+  double compute_time_s = 0;
+};
+
+/// Called after every attempt with the record and the map as it stands.
+using FixationObserver = std::function<void(const FixationRecord&, const PatchMap&)>;
+
+/// Runs FOVEA on a rig. Throws rig::RigError if the rig fails; points that
+/// cannot be fixated are recorded and skipped.
+FoveaRun RunFovea(rig::Rig& rig, const StereoMatcher& matcher, const FoveaOptions& options,
+                  const FixationObserver& observer = {});
+
+}  // namespace fovea

@@ -1,0 +1,161 @@
+// Choosing the next fixation (paper section IV; design note "DDR"): separate,
+// swappable criteria over the pixels of the current left view, each
+// normalized to sum 1; their product; a histogram of it, an exponential draw
+// that favours high values, the pixel nearest the image centre in the drawn
+// bin, raytraced into the map for the 3D point.
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <optional>
+#include <opencv2/core.hpp>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "fovea/patch.h"
+#include "rig/types.h"
+
+namespace fovea {
+
+/// What the criteria may look at.
+struct SelectionContext {
+  cv::Mat image;                ///< current left view, CV_8UC1
+  rig::CameraView view;         ///< its camera
+  cv::Mat map_depth_m;          ///< the map rendered into the view (CV_32F, 0 = none)
+  cv::Mat map_level;            ///< CV_8S: PatchLevel of the patch seen, -1 = none
+  bool has_fixation = false;    ///< false before the first vergent fixation
+  double fixation_depth_m = 0;  ///< depth of the current fixation point in the view
+  double z_t_near_m = 0, z_t_far_m = 0;  ///< the current fovea's depth band (Z_T)
+  std::vector<Eigen::Vector3d> fixated_W;  ///< earlier fixation points
+  /// If set, only points that this view sees (the IDR view: the region the
+  /// run maps) are candidates.
+  std::optional<rig::CameraView> region;
+
+  /// The map point seen at a pixel (requires map_depth_m > 0 there).
+  Eigen::Vector3d MapPoint(int x, int y) const;
+
+  /// Renders `map` into `view` and fills map_depth_m and map_level.
+  static SelectionContext Make(const cv::Mat& image, const rig::CameraView& view, const PatchMap& map);
+};
+
+/// One criterion: a non-negative weight per pixel (CV_64F, the view's size)
+/// that sums to 1 over the image (or is all zero if nothing qualifies).
+class FixationCriterion {
+ public:
+  virtual ~FixationCriterion() = default;
+  virtual std::string Name() const = 0;
+  virtual cv::Mat Evaluate(const SelectionContext& context) const = 0;
+};
+
+/// Squared gradient magnitude (after a Gaussian blur of `blur_sigma_px`, and
+/// averaged over a window of the same scale): attracts the eye to texture.
+class GradientAttraction : public FixationCriterion {
+ public:
+  explicit GradientAttraction(double blur_sigma_px = 2.0) : sigma_(blur_sigma_px) {}
+  std::string Name() const override { return "gradient"; }
+  cv::Mat Evaluate(const SelectionContext& context) const override;
+
+ private:
+  double sigma_;
+};
+
+/// Low weight where the map already holds foveal data or lies within
+/// `radius_m` of an earlier fixation point (a fixation whose fovea yielded
+/// no patches, at a depth edge say, must not attract the eye forever), high
+/// elsewhere.
+class LocalSuppression : public FixationCriterion {
+ public:
+  explicit LocalSuppression(double suppressed_weight = 0.02, double radius_m = 0.04)
+      : low_(suppressed_weight), radius_(radius_m) {}
+  std::string Name() const override { return "suppression"; }
+  cv::Mat Evaluate(const SelectionContext& context) const override;
+
+ private:
+  double low_, radius_;
+};
+
+/// exp(-r / s), r the distance from the image centre in pixels.
+class Proximity2D : public FixationCriterion {
+ public:
+  explicit Proximity2D(double scale_px = 160) : scale_(scale_px) {}
+  std::string Name() const override { return "proximity_2d"; }
+  cv::Mat Evaluate(const SelectionContext& context) const override;
+
+ private:
+  double scale_;
+};
+
+/// Two levels: high where the map depth lies within the current fixation's
+/// Z_T band, low elsewhere (uniform before the first vergent fixation).
+class Proximity3D : public FixationCriterion {
+ public:
+  explicit Proximity3D(double low_weight = 0.1) : low_(low_weight) {}
+  std::string Name() const override { return "proximity_3d"; }
+  cv::Mat Evaluate(const SelectionContext& context) const override;
+
+ private:
+  double low_;
+};
+
+/// Divides by the sum (leaves an all-zero image as it is).
+void NormalizeSum(cv::Mat* weights);
+
+struct SelectionOptions {
+  bool deterministic = false;  ///< always take the maximum of the composite
+  double draw_scale = 0.5;     ///< s of the exponential draw
+  int histogram_bins = 64;
+  int border_px = 16;          ///< candidates keep this far from the image edge
+  /// Candidates whose map point lies within this distance of a point that
+  /// could not be fixated are left out.
+  double refused_radius_m = 0.03;
+  void Check() const;  ///< throws std::invalid_argument naming the field
+};
+
+/// What one choice looked like, for the records.
+struct SelectionSummary {
+  bool ok = false;
+  std::string why;                  ///< when not ok
+  Eigen::Vector2d pixel = Eigen::Vector2d::Zero();
+  Eigen::Vector3d point_W = Eigen::Vector3d::Zero();
+  int candidates = 0;               ///< pixels with a map point
+  double composite_max = 0, composite_chosen = 0;
+  double drawn_value = 0;           ///< c drawn from the exponential density
+  int bin = -1;
+  /// Per criterion: its name, its value at the chosen pixel relative to its
+  /// mean over the candidates (1 = average, > 1 = favoured).
+  std::vector<std::pair<std::string, double>> criteria;
+};
+
+/// The composite selection rule over a set of criteria. All randomness comes
+/// from the generator passed in.
+class FixationSelector {
+ public:
+  /// The paper's four criteria with their default settings.
+  static std::vector<std::shared_ptr<const FixationCriterion>> DefaultCriteria();
+
+  FixationSelector(std::vector<std::shared_ptr<const FixationCriterion>> criteria,
+                   const SelectionOptions& options);
+
+  /// Product of the criteria, normalized, zero where the map has no point,
+  /// near the border or near a refused point.
+  cv::Mat Composite(const SelectionContext& context, const std::vector<Eigen::Vector3d>& refused_W,
+                    std::vector<cv::Mat>* each = nullptr) const;
+
+  /// Draws the next fixation point.
+  SelectionSummary Choose(const SelectionContext& context, const PatchMap& map,
+                          const std::vector<Eigen::Vector3d>& refused_W, std::mt19937_64* rng) const;
+
+  const std::vector<std::shared_ptr<const FixationCriterion>>& criteria() const { return criteria_; }
+
+ private:
+  std::vector<std::shared_ptr<const FixationCriterion>> criteria_;
+  SelectionOptions options_;
+};
+
+/// The exponential draw of the design note: u in [0, 1] with density
+/// proportional to exp(-u / s), by inverting its CDF at r in [0, 1); the
+/// value drawn is c_max (1 - u).
+double DrawExponential(double r, double scale);
+
+}  // namespace fovea

@@ -1,0 +1,234 @@
+#include "fovea/selection.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+
+#include "fovea/geometry.h"
+
+namespace fovea {
+
+SelectionContext SelectionContext::Make(const cv::Mat& image, const rig::CameraView& view, const PatchMap& map) {
+  SelectionContext c;
+  c.image = image;
+  c.view = view;
+  cv::Mat ids;
+  map.Render(view.world_T_camera, view.intrinsics, &c.map_depth_m, &ids);
+  c.map_level = cv::Mat(ids.size(), CV_8S, cv::Scalar(-1));
+  for (int y = 0; y < ids.rows; ++y)
+    for (int x = 0; x < ids.cols; ++x) {
+      const int id = ids.at<int>(y, x);
+      if (id >= 0) c.map_level.at<signed char>(y, x) = static_cast<signed char>(map[id].level);
+    }
+  return c;
+}
+
+void NormalizeSum(cv::Mat* w) {
+  const double s = cv::sum(*w)[0];
+  if (s > 0) *w /= s;
+}
+
+cv::Mat GradientAttraction::Evaluate(const SelectionContext& c) const {
+  cv::Mat f, gx, gy;
+  c.image.convertTo(f, CV_64F);
+  cv::GaussianBlur(f, f, cv::Size(), sigma_);
+  cv::Sobel(f, gx, CV_64F, 1, 0, 3, 1.0 / 8);
+  cv::Sobel(f, gy, CV_64F, 0, 1, 3, 1.0 / 8);
+  cv::Mat g = gx.mul(gx) + gy.mul(gy);
+  // Texture is a regional property: average the energy over a window.
+  cv::GaussianBlur(g, g, cv::Size(), 2 * sigma_);
+  // Saturate at the 80th percentile: every well-textured region attracts
+  // alike, so that the strong contrast of an occluding edge does not hold
+  // the eye on the edge fixation after fixation.
+  std::vector<double> v(g.begin<double>(), g.end<double>());
+  std::nth_element(v.begin(), v.begin() + v.size() * 8 / 10, v.end());
+  const double cap = v[v.size() * 8 / 10];
+  if (cap > 0) cv::min(g, cap, g);
+  NormalizeSum(&g);
+  return g;
+}
+
+Eigen::Vector3d SelectionContext::MapPoint(int x, int y) const {
+  return view.world_T_camera * (map_depth_m.at<float>(y, x) * view.intrinsics.Ray({double(x), double(y)}));
+}
+
+cv::Mat LocalSuppression::Evaluate(const SelectionContext& c) const {
+  cv::Mat w(c.map_level.size(), CV_64F, cv::Scalar(1.0));
+  for (int y = 0; y < w.rows; ++y)
+    for (int x = 0; x < w.cols; ++x) {
+      if (c.map_level.at<signed char>(y, x) == static_cast<signed char>(PatchLevel::kFoveal)) {
+        w.at<double>(y, x) = low_;
+        continue;
+      }
+      if (c.fixated_W.empty() || c.map_depth_m.at<float>(y, x) <= 0) continue;
+      const Eigen::Vector3d p = c.MapPoint(x, y);
+      for (const Eigen::Vector3d& f : c.fixated_W)
+        if ((p - f).norm() < radius_) {
+          w.at<double>(y, x) = low_;
+          break;
+        }
+    }
+  NormalizeSum(&w);
+  return w;
+}
+
+cv::Mat Proximity2D::Evaluate(const SelectionContext& c) const {
+  cv::Mat w(c.image.size(), CV_64F);
+  const double cx = c.view.intrinsics.cx_px, cy = c.view.intrinsics.cy_px;
+  for (int y = 0; y < w.rows; ++y)
+    for (int x = 0; x < w.cols; ++x) w.at<double>(y, x) = std::exp(-std::hypot(x - cx, y - cy) / scale_);
+  NormalizeSum(&w);
+  return w;
+}
+
+cv::Mat Proximity3D::Evaluate(const SelectionContext& c) const {
+  cv::Mat w(c.map_depth_m.size(), CV_64F, cv::Scalar(1.0));
+  if (c.has_fixation) {
+    const double lo = c.fixation_depth_m - c.z_t_near_m, hi = c.fixation_depth_m + c.z_t_far_m;
+    for (int y = 0; y < w.rows; ++y)
+      for (int x = 0; x < w.cols; ++x) {
+        const float z = c.map_depth_m.at<float>(y, x);
+        if (!(z > 0 && z >= lo && z <= hi)) w.at<double>(y, x) = low_;
+      }
+  }
+  NormalizeSum(&w);
+  return w;
+}
+
+void SelectionOptions::Check() const {
+  auto bad = [](const std::string& what) { throw std::invalid_argument(what); };
+  if (!(draw_scale > 0)) bad("selection.draw_scale must be > 0, got " + std::to_string(draw_scale));
+  if (histogram_bins < 2 || histogram_bins > 4096)
+    bad("selection.histogram_bins must be 2 to 4096, got " + std::to_string(histogram_bins));
+  if (border_px < 0) bad("selection.border_px must be >= 0, got " + std::to_string(border_px));
+  if (!(refused_radius_m >= 0)) bad("selection.refused_radius_m must be >= 0, got " + std::to_string(refused_radius_m));
+}
+
+std::vector<std::shared_ptr<const FixationCriterion>> FixationSelector::DefaultCriteria() {
+  return {std::make_shared<GradientAttraction>(), std::make_shared<LocalSuppression>(),
+          std::make_shared<Proximity2D>(), std::make_shared<Proximity3D>()};
+}
+
+FixationSelector::FixationSelector(std::vector<std::shared_ptr<const FixationCriterion>> criteria,
+                                   const SelectionOptions& options)
+    : criteria_(std::move(criteria)), options_(options) {
+  options_.Check();
+}
+
+cv::Mat FixationSelector::Composite(const SelectionContext& c, const std::vector<Eigen::Vector3d>& refused_W,
+                                    std::vector<cv::Mat>* each) const {
+  cv::Mat composite(c.image.size(), CV_64F, cv::Scalar(1.0));
+  if (each) each->clear();
+  for (const auto& criterion : criteria_) {
+    const cv::Mat w = criterion->Evaluate(c);
+    composite = composite.mul(w);
+    if (each) each->push_back(w);
+  }
+  // Only pixels the map can raytrace, away from the border and from refused points.
+  const int b = options_.border_px;
+  for (int y = 0; y < composite.rows; ++y)
+    for (int x = 0; x < composite.cols; ++x) {
+      double& v = composite.at<double>(y, x);
+      const float z = c.map_depth_m.at<float>(y, x);
+      if (z <= 0 || x < b || y < b || x >= composite.cols - b || y >= composite.rows - b) {
+        v = 0;
+        continue;
+      }
+      if (refused_W.empty() && !c.region) continue;
+      const Eigen::Vector3d p_W = c.MapPoint(x, y);
+      if (c.region) {
+        const auto uv = ProjectWorldPoint(c.region->world_T_camera, c.region->intrinsics, p_W);
+        const auto& k = c.region->intrinsics;
+        if (!uv || uv->x() < b || uv->y() < b || uv->x() > k.width_px - 1 - b || uv->y() > k.height_px - 1 - b) {
+          v = 0;
+          continue;
+        }
+      }
+      for (const Eigen::Vector3d& r : refused_W)
+        if ((p_W - r).norm() < options_.refused_radius_m) v = 0;
+    }
+  NormalizeSum(&composite);
+  return composite;
+}
+
+double DrawExponential(double r, double s) {
+  // CDF F(u) = (1 - exp(-u / s)) / (1 - exp(-1 / s)) on [0, 1].
+  return -s * std::log1p(-r * (1 - std::exp(-1 / s)));
+}
+
+SelectionSummary FixationSelector::Choose(const SelectionContext& c, const PatchMap& map,
+                                          const std::vector<Eigen::Vector3d>& refused_W,
+                                          std::mt19937_64* rng) const {
+  SelectionSummary s;
+  std::vector<cv::Mat> each;
+  const cv::Mat composite = Composite(c, refused_W, &each);
+  double c_max = 0;
+  cv::minMaxLoc(composite, nullptr, &c_max);
+  s.composite_max = c_max;
+  s.candidates = cv::countNonZero(composite > 0);
+  if (c_max <= 0) {
+    s.why = "no candidate pixel: the map shows nothing in view that may be fixated";
+    return s;
+  }
+  const double cx = c.view.intrinsics.cx_px, cy = c.view.intrinsics.cy_px;
+  auto centre_dist = [&](int x, int y) { return std::hypot(x - cx, y - cy); };
+  const int bins = options_.histogram_bins;
+  auto bin_of = [&](double v) { return std::min(bins - 1, static_cast<int>(v / c_max * bins)); };
+  int chosen_bin;
+  if (options_.deterministic) {
+    chosen_bin = bins - 1;
+    s.drawn_value = c_max;
+  } else {
+    // 53 random bits -> [0, 1): the same on every platform, unlike the
+    // standard distributions.
+    const double r = static_cast<double>((*rng)() >> 11) * 0x1.0p-53;
+    s.drawn_value = c_max * (1 - DrawExponential(r, options_.draw_scale));
+    std::vector<int> count(bins, 0);
+    for (int y = 0; y < composite.rows; ++y)
+      for (int x = 0; x < composite.cols; ++x) {
+        const double v = composite.at<double>(y, x);
+        if (v > 0) ++count[bin_of(v)];
+      }
+    const int target = bin_of(s.drawn_value);
+    chosen_bin = -1;
+    for (int d = 0; d < bins && chosen_bin < 0; ++d) {
+      if (target + d < bins && count[target + d] > 0) chosen_bin = target + d;
+      else if (target - d >= 0 && count[target - d] > 0) chosen_bin = target - d;
+    }
+  }
+  s.bin = chosen_bin;
+  // In deterministic mode, the maximum itself; otherwise the bin's pixel
+  // nearest the image centre.
+  int bx = -1, by = -1;
+  double best_value = -1, best_dist = std::numeric_limits<double>::infinity();
+  for (int y = 0; y < composite.rows; ++y)
+    for (int x = 0; x < composite.cols; ++x) {
+      const double v = composite.at<double>(y, x);
+      if (v <= 0) continue;
+      const double d = centre_dist(x, y);
+      const bool better = options_.deterministic
+                              ? (v > best_value || (v == best_value && d < best_dist))
+                              : (bin_of(v) == chosen_bin && d < best_dist);
+      if (better) best_value = v, best_dist = d, bx = x, by = y;
+    }
+  s.pixel = Eigen::Vector2d(bx, by);
+  s.composite_chosen = composite.at<double>(by, bx);
+  const Ray ray = PixelRay(c.view.world_T_camera, c.view.intrinsics, s.pixel);
+  const auto hit = map.CastRay(ray.origin_W, ray.direction_W);
+  if (!hit) {
+    s.why = "the chosen pixel's ray misses the map";
+    return s;
+  }
+  s.point_W = ray.origin_W + hit->distance_m * ray.direction_W;
+  const cv::Mat candidates = composite > 0;
+  for (size_t i = 0; i < criteria_.size(); ++i) {
+    const double mean = cv::mean(each[i], candidates)[0];
+    s.criteria.emplace_back(criteria_[i]->Name(), mean > 0 ? each[i].at<double>(by, bx) / mean : 0.0);
+  }
+  s.ok = true;
+  return s;
+}
+
+}  // namespace fovea

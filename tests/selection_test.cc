@@ -1,0 +1,110 @@
+// Fixation selection: normalized criteria, their product, the exponential
+// draw, the deterministic mode, refused points.
+#include <catch2/catch.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "fovea/selection.h"
+
+namespace {
+
+rig::CameraView View() {
+  rig::CameraView v;
+  v.intrinsics.width_px = 160;
+  v.intrinsics.height_px = 120;
+  v.intrinsics.fx_px = v.intrinsics.fy_px = 150;
+  v.intrinsics.cx_px = 79.5;
+  v.intrinsics.cy_px = 59.5;
+  v.world_T_camera = Eigen::Isometry3d::Identity();
+  v.world_T_camera.linear() << 1, 0, 0, 0, 0, 1, 0, -1, 0;
+  return v;
+}
+
+fovea::Patch Square(double x0, double x1, double z0, double z1, double y, fovea::PatchLevel level) {
+  fovea::Patch p;
+  p.corners_W = {Eigen::Vector3d(x0, y, z0), Eigen::Vector3d(x1, y, z0), Eigen::Vector3d(x1, y, z1),
+                 Eigen::Vector3d(x0, y, z1)};
+  p.level = level;
+  return p;
+}
+
+// Texture only in the right half of the image.
+cv::Mat HalfTextured() {
+  cv::Mat img(120, 160, CV_8U, cv::Scalar(128));
+  cv::Mat noise(120, 80, CV_8U);
+  cv::randu(noise, 0, 255);
+  noise.copyTo(img(cv::Rect(80, 0, 80, 120)));
+  return img;
+}
+
+}  // namespace
+
+TEST_CASE("each criterion is normalized and says what it should", "[fovea][selection]") {
+  fovea::PatchMap map;
+  map.Add(Square(-1, 0, -1, 1, 1.0, fovea::PatchLevel::kFoveal));  // left half: foveal, 1 m
+  map.Add(Square(0, 1, -1, 1, 2.0, fovea::PatchLevel::kIdr));      // right half: IDR, 2 m
+  fovea::SelectionContext c = fovea::SelectionContext::Make(HalfTextured(), View(), map);
+  c.has_fixation = true;
+  c.fixation_depth_m = 1.0;
+  c.z_t_near_m = c.z_t_far_m = 0.1;
+  for (const auto& criterion : fovea::FixationSelector::DefaultCriteria()) {
+    INFO(criterion->Name());
+    const cv::Mat w = criterion->Evaluate(c);
+    CHECK(cv::sum(w)[0] == Approx(1.0));
+    double lo;
+    cv::minMaxLoc(w, &lo);
+    CHECK(lo >= 0);
+  }
+  const fovea::GradientAttraction gradient;
+  const fovea::LocalSuppression suppression(0.02, 0.0);
+  const fovea::Proximity2D p2d(40);
+  const fovea::Proximity3D p3d(0.1);
+  CHECK(gradient.Evaluate(c).at<double>(60, 120) > 20 * gradient.Evaluate(c).at<double>(60, 30));
+  CHECK(suppression.Evaluate(c).at<double>(60, 120) == Approx(50 * suppression.Evaluate(c).at<double>(60, 30)));
+  CHECK(p2d.Evaluate(c).at<double>(60, 80) > p2d.Evaluate(c).at<double>(5, 5));
+  CHECK(p3d.Evaluate(c).at<double>(60, 30) == Approx(10 * p3d.Evaluate(c).at<double>(60, 120)));
+}
+
+TEST_CASE("the exponential draw favours high values with the scale asked for", "[fovea][selection]") {
+  CHECK(fovea::DrawExponential(0.0, 0.5) == 0.0);
+  CHECK(fovea::DrawExponential(1.0 - 1e-12, 0.5) == Approx(1.0).margin(1e-6));
+  // Mean of u under density ~ exp(-u / s) on [0, 1], s = 0.5: s - e^(-1/s) / (1 - e^(-1/s)).
+  double mean = 0;
+  const int n = 100000;
+  for (int i = 0; i < n; ++i) mean += fovea::DrawExponential((i + 0.5) / n, 0.5);
+  mean /= n;
+  CHECK(mean == Approx(0.5 - std::exp(-2.0) / (1 - std::exp(-2.0))).epsilon(1e-3));
+  CHECK(fovea::DrawExponential(0.5, 0.1) < fovea::DrawExponential(0.5, 0.5));
+}
+
+TEST_CASE("selection: deterministic takes the maximum; draws are reproducible from the seed", "[fovea][selection]") {
+  fovea::PatchMap map;
+  map.Add(Square(-1, 0, -1, 1, 1.0, fovea::PatchLevel::kFoveal));
+  map.Add(Square(0, 1, -1, 1, 1.0, fovea::PatchLevel::kIdr));
+  const fovea::SelectionContext c = fovea::SelectionContext::Make(HalfTextured(), View(), map);
+  fovea::SelectionOptions o;
+  o.deterministic = true;
+  const fovea::FixationSelector det(fovea::FixationSelector::DefaultCriteria(), o);
+  std::mt19937_64 rng(1);
+  const auto s = det.Choose(c, map, {}, &rng);
+  REQUIRE(s.ok);
+  CHECK(s.composite_chosen == s.composite_max);
+  CHECK(s.pixel.x() >= 80);                       // on the texture, not the foveal half
+  CHECK(s.point_W.y() == Approx(1.0).margin(1e-9));  // raytraced into the map
+
+  o.deterministic = false;
+  const fovea::FixationSelector drawn(fovea::FixationSelector::DefaultCriteria(), o);
+  std::mt19937_64 a(7), b(7), other(8);
+  std::vector<Eigen::Vector2d> pa, pb, po;
+  for (int i = 0; i < 10; ++i) {
+    pa.push_back(drawn.Choose(c, map, {}, &a).pixel);
+    pb.push_back(drawn.Choose(c, map, {}, &b).pixel);
+    po.push_back(drawn.Choose(c, map, {}, &other).pixel);
+  }
+  CHECK(pa == pb);
+  CHECK(pa != po);
+
+  // A refused point takes its neighbourhood out of the candidates.
+  const auto refused = det.Choose(c, map, {s.point_W}, &rng);
+  REQUIRE(refused.ok);
+  CHECK((refused.point_W - s.point_W).norm() >= o.refused_radius_m);
+}
