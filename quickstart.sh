@@ -37,10 +37,10 @@ case "${1:-}" in
     install_packages
     build build -DCMAKE_BUILD_TYPE=Release
     mkdir -p out
-    ./build/experiments/fovea render --out out/render_home
-    ./build/experiments/fovea render --state -0.08,-2.5,1,0.08,2.5,1 --out out/render_verged
-    ./build/experiments/fovea catalog --out out
-    echo "quickstart: pictures and figures are in out/"
+    # The main job: a full FOVEA run (IDR, then 25 fixations) on the default
+    # scene, cylinder_planes, scored against ground truth after each fixation.
+    ./build/experiments/fovea run --scene cylinder_planes --out out/run
+    echo "quickstart: pictures and figures are in out/run/ (summary.json, fixations.jsonl, map.ply, map_after_*.png, fixation_path.png)"
     ;;
   test)
     install_packages
