@@ -6,6 +6,7 @@
 #include "fovea/idr.h"
 #include "fovea/sgbm.h"
 #include "output.h"
+#include "run_output.h"
 #include "scene_options.h"
 
 namespace experiments {
@@ -57,14 +58,7 @@ int Fixate(const FixateArgs& args) {
     WriteImageAtomic(args.out + "/disparity_level" + std::to_string(k) + ".png", colour);
   }
   // This fixation's patches beside the true depth, from the left camera.
-  cv::Mat patch_depth;
-  r.foveal.patches.Render(left.world_T_camera, left.intrinsics, &patch_depth, nullptr);
-  const sim::TrueView truth = sim->truth().Render(left.world_T_camera, left.intrinsics);
-  double lo = 0, hi = 0;
-  cv::minMaxLoc(truth.depth_m, &lo, &hi, nullptr, nullptr, truth.depth_m > 0);
-  cv::Mat side;
-  cv::hconcat(ColorizeDepth(patch_depth, lo, hi), ColorizeDepth(truth.depth_m, lo, hi), side);
-  WriteImageAtomic(args.out + "/patch_depth_vs_true.png", side);
+  WriteImageAtomic(args.out + "/patch_depth_vs_true.png", PatchDepthBesideTruth(r.foveal.patches, left, sim->truth()));
 
   nlohmann::json j = FixationJson(r, score);
   j["scene"] = sim->scene_path();

@@ -4,6 +4,7 @@
 #include "commands.h"
 #include "idr_eval.h"
 #include "output.h"
+#include "run_output.h"
 #include "scene_options.h"
 
 namespace experiments {
@@ -37,14 +38,7 @@ int Idr(const IdrArgs& args) {
   }
   WriteImageAtomic(args.out + "/disparity.png", disparity);
   // Patch depth beside true depth, one colour scale.
-  cv::Mat patch_depth;
-  r.map.Render(left.world_T_camera, left.intrinsics, &patch_depth, nullptr);
-  const sim::TrueView truth = sim->truth().Render(left.world_T_camera, left.intrinsics);
-  double lo = 0, hi = 0;
-  cv::minMaxLoc(truth.depth_m, &lo, &hi, nullptr, nullptr, truth.depth_m > 0);
-  cv::Mat side;
-  cv::hconcat(ColorizeDepth(patch_depth, lo, hi), ColorizeDepth(truth.depth_m, lo, hi), side);
-  WriteImageAtomic(args.out + "/patch_depth_vs_true.png", side);
+  WriteImageAtomic(args.out + "/patch_depth_vs_true.png", PatchDepthBesideTruth(r.map, left, sim->truth()));
 
   nlohmann::json j = IdrJson(r, score);
   j["scene"] = sim->scene_path();

@@ -83,6 +83,18 @@ cv::Mat ObliqueView(const fovea::PatchMap& map, const Eigen::Vector3d& target_W,
   return img;
 }
 
+cv::Mat PatchDepthBesideTruth(const fovea::PatchMap& map, const rig::CameraView& view,
+                              const sim::GroundTruth& truth) {
+  cv::Mat patch_depth;
+  map.Render(view.world_T_camera, view.intrinsics, &patch_depth, nullptr);
+  const sim::TrueView true_view = truth.Render(view.world_T_camera, view.intrinsics);
+  double lo = 0, hi = 0;
+  cv::minMaxLoc(true_view.depth_m, &lo, &hi, nullptr, nullptr, true_view.depth_m > 0);
+  cv::Mat side;
+  cv::hconcat(ColorizeDepth(patch_depth, lo, hi), ColorizeDepth(true_view.depth_m, lo, hi), side);
+  return side;
+}
+
 cv::Mat MapSnapshot(const fovea::PatchMap& map, const ReferenceView& ref, const Eigen::Vector3d& target_W,
                     const std::string& caption) {
   const int w = ref.view.intrinsics.width_px, h = ref.view.intrinsics.height_px;

@@ -23,6 +23,11 @@ std::string PatchMapPly(const fovea::PatchMap& map);
 /// coloured by level.
 cv::Mat ObliqueView(const fovea::PatchMap& map, const Eigen::Vector3d& target_W, int width_px, int height_px);
 
+/// The map's depth seen by `view` beside the true depth there, one colour
+/// scale (the true depth's range).
+cv::Mat PatchDepthBesideTruth(const fovea::PatchMap& map, const rig::CameraView& view,
+                              const sim::GroundTruth& truth);
+
 /// The map after a fixation as the paper shows it: the oblique view, the
 /// map's depth in the reference view and the true depth (same colours), with
 /// a caption.
