@@ -142,3 +142,53 @@ TEST_CASE("bad input gives one line on stderr, a non-zero exit and no output", "
   }
   fs::remove_all(dir);
 }
+
+TEST_CASE("bad sweep files each give one line naming the key, exit 2 and no output folder", "[cli][sweep]") {
+  const fs::path out = TempDir("sweep_bad");
+  const fs::path dir = TempDir("sweeps");
+  fs::create_directories(dir);
+  struct Case {
+    std::string name, text, expect;
+  };
+  const std::vector<Case> cases = {
+      {"unknown_key", "config: {loop: {fixation: 3}}\naxes: {seed: [0, 1]}\n", "unknown key 'loop.fixation'"},
+      {"wrong_type", "config: {loop: {fixations: many}}\naxes: {seed: [0, 1]}\n", "key 'loop.fixations': expected a number"},
+      {"negative_baseline", "axes: {foveal.baseline_m: [0.1, -0.1]}\n", "key 'foveal.baseline_m': -0.1 is out of range"},
+      {"zero_fixations", "axes: {loop.fixations: [0, 5]}\n", "key 'loop.fixations': 0 is out of range [1, 10000]"},
+      {"missing_scene", "axes: {scene: [two_planes, no_such_scene]}\n", "unknown scene 'no_such_scene'"},
+      {"missing_scene_file", "axes: {scene: [/nonexistent/scene.xml]}\n", "scene '/nonexistent/scene.xml': no such file"},
+      {"not_yaml", "axes: [1, 2\n", "not valid YAML"},
+      {"unknown_axis", "axes: {foveal.nope: [1, 2]}\n", "unknown key 'foveal.nope'"},
+      {"no_axes", "config: {seed: 3}\n", "key 'axes'"},
+      {"bad_range", "axes: {seed: {from: 3, to: 1, step: 1}}\n", "range needs from <= to"},
+      {"unknown_top_key", "axis: {seed: [0]}\n", "unknown key 'axis'"},
+      {"missing_base", "base: nope.yaml\naxes: {seed: [0]}\n", "cannot read"},
+      {"too_wide", "config: {rig: {carriage_max_m: 0.05}}\naxes: {foveal.baseline_m: [0.08, 0.12]}\n",
+       "key 'foveal.baseline_m': 0.12 is wider than the carriages allow"},
+      {"unknown_baseline", "axes: {seed: [0]}\nbaselines: [oracle]\n", "'oracle' is not one of"},
+      {"bad_jobs", "axes: {seed: [0]}\njobs: -1\n", "key 'jobs'"},
+      {"bad_bool", "axes: {criteria.suppression: [yes_please]}\n", "expected true or false"},
+  };
+  for (const Case& c : cases) {
+    const fs::path file = dir / (c.name + ".yaml");
+    std::ofstream(file) << c.text;
+    const Result r = Fovea("sweep " + file.string() + " --out " + out.string());
+    INFO(c.name << " -> exit " << r.exit_code << ": " << r.err);
+    CHECK(r.exit_code == 2);
+    CHECK(Lines(r.err) == 1);
+    CHECK(r.err.find(c.expect) != std::string::npos);
+    CHECK_FALSE(fs::exists(out));
+  }
+  const fs::path good = dir / "good.yaml";
+  std::ofstream(good) << "axes: {seed: [0, 1]}\n";
+  for (const std::string& args : std::vector<std::string>{"sweep /nonexistent/sweep.yaml", "sweep " + good.string() + " --shard 3/2",
+                                  "sweep " + good.string() + " --shard x", "collect /nonexistent/folder",
+                                  "report /nonexistent/folder"}) {
+    const Result r = Fovea(args + (args.rfind("sweep", 0) == 0 ? " --out " + out.string() : ""));
+    INFO(args << " -> exit " << r.exit_code << ": " << r.err);
+    CHECK(r.exit_code == 2);
+    CHECK(Lines(r.err) == 1);
+    CHECK_FALSE(fs::exists(out));
+  }
+  fs::remove_all(dir);
+}

@@ -14,5 +14,6 @@ void AddCatalogCommands(CLI::App& app, std::function<int()>* run);
 void AddIdrCommand(CLI::App& app, std::function<int()>* run);
 void AddFixateCommand(CLI::App& app, std::function<int()>* run);
 void AddRunCommand(CLI::App& app, std::function<int()>* run);
+void AddSweepCommands(CLI::App& app, std::function<int()>* run);
 
 }  // namespace experiments

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -78,8 +79,19 @@ std::vector<ConfigParam> ConfigParams(RunConfig* c) {
   return {
       {"scene", "catalog scene name or path to an MJCF scene file (empty: cylinder_planes)", &c->scene},
       {"seed", "the one seed: sensor noise and every fixation draw", &c->seed, 0, 9007199254740992.0},
+      {"method", "fovea: the FOVEA loop; static_sgbm: the baseline, StereoSGBM on the static pair at the home pose and widest baseline", &c->method, 0, 0, {"fovea", "static_sgbm"}},
       {"matcher", "matcher of the foveated stage", &c->matcher, 0, 0, {"nl1", "sgbm"}},
-      {"rig.noise_sigma_dn", "sensor read noise, grey levels (0 = off)", &c->noise_sigma_dn, 0, 50},
+      {"rig.width_px", "image width, pixels", &c->rig.width_px, 64, 4096},
+      {"rig.height_px", "image height, pixels", &c->rig.height_px, 48, 4096},
+      {"rig.horizontal_fov_deg", "lens: horizontal field of view edge to edge, degrees (16 mm lens: 30)", &c->rig.horizontal_fov_deg, 5, 100},
+      {"rig.carriage_max_m", "baseline axes: each carriage's travel from the rail centre, metres", &c->rig.carriage_max_m, 0.01, 2},
+      {"rig.home_baseline_m", "baseline at the home pose (the reference view's pose), metres", &c->rig.home_baseline_m, 0.002, 4},
+      {"rig.pan_limit_deg", "pan axes: symmetric travel limit, degrees", &c->rig.pan_limit_deg, 1, 179},
+      {"rig.tilt_limit_deg", "tilt axes: symmetric travel limit, degrees", &c->rig.tilt_limit_deg, 1, 89},
+      {"rig.baseline_steps_per_mm", "baseline axes: motor steps per millimetre", &c->rig.baseline_steps_per_mm, 1, 1e6},
+      {"rig.pan_tilt_steps_per_deg", "pan and tilt axes: motor steps per degree", &c->rig.pan_tilt_steps_per_deg, 1, 1e6},
+      {"rig.noise_sigma_dn", "sensor read noise, grey levels (0 = off)", &c->rig.noise.read_noise_sigma_dn, 0, 50},
+      {"rig.blur_sigma_px", "optical blur before the noise, pixels (0 = off)", &c->rig.noise.blur_sigma_px, 0, 10},
       {"loop.fixations", "successful fixations to make", &f.fixations, 1, 10000},
       {"loop.stay_in_idr_view", "fixate only points inside the IDR view (the region the run maps)", &f.stay_in_idr_view},
       {"loop.stall_fixations", "stop when the foveal share grew by less than stall_growth over this many fixations (0 = never)", &f.stall_fixations, 0, 10000},
@@ -114,6 +126,7 @@ std::vector<ConfigParam> ConfigParams(RunConfig* c) {
       {"criteria.suppression_radius_m", "local suppression also covers this distance around earlier fixation points, metres", &f.criteria.suppression_radius_m, 0, 1},
       {"criteria.proximity_2d_scale_px", "2D proximity's scale s in exp(-r / s), pixels", &f.criteria.proximity_2d_scale_px, 1, kBig},
       {"criteria.proximity_3d_low", "3D proximity's weight outside the Z_T band (1 inside)", &f.criteria.proximity_3d_low, 0, 1},
+      {"static.baseline_m", "static_sgbm's baseline, metres (0 = the widest at which a point at idr.z_min_m keeps within half the image width)", &c->static_baseline_m, 0, 4},
       {"integration.overlap_share", "overlap share at which new patches replace old ones (and finer data blocks new ones)", &f.integration.overlap_share, 0.01, 1},
   };
 }
@@ -159,18 +172,68 @@ RunConfig LoadConfig(const std::string& path) {
     throw UsageError(where + "not valid YAML (line " + std::to_string(e.mark.line + 1) + ": " + e.msg + ")");
   }
   RunConfig config;
-  if (root.IsNull()) return config;
-  if (!root.IsMap()) throw UsageError(where + "expected a mapping of keys at the top level");
-  const std::vector<ConfigParam> params = ConfigParams(&config);
-  std::map<std::string, const ConfigParam*> by_path;
-  for (const ConfigParam& p : params) by_path[p.path] = &p;
-  Walk(root, "", by_path, where);
+  ApplyYaml(root, &config, where);
   try {
-    config.fovea.Check();
-  } catch (const std::invalid_argument& e) {
+    config.Check();
+  } catch (const UsageError& e) {
     throw UsageError(where + e.what());
   }
   return config;
+}
+
+void ApplyYaml(const YAML::Node& root, RunConfig* config, const std::string& where) {
+  if (root.IsNull()) return;
+  if (!root.IsMap()) throw UsageError(where + "expected a mapping of keys at the top level");
+  const std::vector<ConfigParam> params = ConfigParams(config);
+  std::map<std::string, const ConfigParam*> by_path;
+  for (const ConfigParam& p : params) by_path[p.path] = &p;
+  Walk(root, "", by_path, where);
+}
+
+void RunConfig::Check() const {
+  try {
+    fovea.Check();
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  sim::SimRigConfig r = rig;
+  r.seed = seed;
+  try {
+    r.Check();
+  } catch (const sim::SceneError& e) {
+    throw UsageError(e.what());
+  }
+  const double widest = 2 * rig.carriage_max_m;
+  if (rig.home_baseline_m > widest)
+    throw UsageError("key 'rig.home_baseline_m': " + FormatNumber(rig.home_baseline_m) +
+                     " is wider than the carriages allow (2 x rig.carriage_max_m = " + FormatNumber(widest) + ")");
+  if (fovea.fixation.baseline_m > widest)
+    throw UsageError("key 'foveal.baseline_m': " + FormatNumber(fovea.fixation.baseline_m) +
+                     " is wider than the carriages allow (2 x rig.carriage_max_m = " + FormatNumber(widest) + ")");
+}
+
+std::string CanonicalConfig(const RunConfig& const_config) {
+  RunConfig config = const_config;
+  std::string text;
+  for (const ConfigParam& p : ConfigParams(&config)) text += p.path + "=" + ValueText(p) + "\n";
+  return text;
+}
+
+std::string ConfigHash(const RunConfig& config) {
+  uint64_t h = 1469598103934665603ull;
+  for (const unsigned char ch : CanonicalConfig(config)) {
+    h ^= ch;
+    h *= 1099511628211ull;
+  }
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+std::string ParamText(RunConfig* config, const std::string& path) {
+  for (const ConfigParam& p : ConfigParams(config))
+    if (p.path == path) return ValueText(p);
+  throw UsageError("unknown key '" + path + "'");
 }
 
 std::string DumpConfig(const RunConfig& const_config) {

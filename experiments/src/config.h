@@ -6,19 +6,33 @@
 #include <cstdint>
 #include <string>
 #include <variant>
+#include <yaml-cpp/node/node.h>
 #include <vector>
 
 #include "fovea/ddr.h"
+#include "sim/config.h"
 
 namespace experiments {
 
 struct RunConfig {
+  RunConfig() { rig.noise.read_noise_sigma_dn = 2.0; }
   std::string scene;                 ///< catalog name or path; empty = the default scene
   uint64_t seed = 0;                 ///< the one seed: sensor noise and fixation draws
+  /// "fovea": the FOVEA loop; "static_sgbm": the baseline it is compared
+  /// with, StereoSGBM on a static parallel pair at the home pose and the
+  /// widest baseline, scored the same way.
+  std::string method = "fovea";
   std::string matcher = "nl1";       ///< per-level matcher of the foveated stage
-  double noise_sigma_dn = 2.0;       ///< sensor read noise, grey levels
+  sim::SimRigConfig rig;             ///< the simulated rig (its seed is `seed`)
+  double static_baseline_m = 0;      ///< static_sgbm's baseline; 0 = the widest useful
   fovea::FoveaOptions fovea;
+
+  /// Checks what single ranges cannot (the parts against each other);
+  /// throws UsageError naming the key.
+  void Check() const;
 };
+
+
 
 /// One parameter: a path in the YAML file ("idr.unique_share"), what it is,
 /// and where it lives in a RunConfig.
@@ -48,5 +62,20 @@ void SetParam(RunConfig* config, const std::string& path, const std::string& val
 /// The full effective configuration as YAML, each key with its meaning and
 /// range as a comment.
 std::string DumpConfig(const RunConfig& config);
+
+/// Every parameter as "path=value" lines in table order: the canonical text
+/// that names a run (see ConfigHash).
+std::string CanonicalConfig(const RunConfig& config);
+
+/// A stable 64-bit FNV-1a hash of CanonicalConfig, as 16 hex digits: the
+/// same on every machine and build.
+std::string ConfigHash(const RunConfig& config);
+
+/// The value of one parameter as text (as written in the YAML file).
+std::string ParamText(RunConfig* config, const std::string& path);
+
+/// Reads the keys of a YAML mapping over `config` (as LoadConfig does for a
+/// file); `where` prefixes every error message.
+void ApplyYaml(const YAML::Node& root, RunConfig* config, const std::string& where);
 
 }  // namespace experiments

@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
   experiments::AddIdrCommand(app, &run);
   experiments::AddFixateCommand(app, &run);
   experiments::AddRunCommand(app, &run);
+  experiments::AddSweepCommands(app, &run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -1,5 +1,6 @@
 #include "fovea/sgbm.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <opencv2/calib3d.hpp>
@@ -72,9 +73,14 @@ cv::Mat RectifiedSgbmDepth(const rig::CameraView& left, const rig::CameraView& r
   const double min_disparity_px = fb / max_depth_m, max_disparity_px = fb / min_depth_m;
   const int min_d = static_cast<int>(std::floor(min_disparity_px)) - 1;
   const int num_d = ((static_cast<int>(std::ceil(max_disparity_px)) + 2 - min_d + 15) / 16) * 16;
-  cv::Mat d16, d, xyz;
-  Make(options, min_d, num_d)->compute(lr, rr, d16);
-  d16.convertTo(d, CV_32F, 1.0 / 16);
+  // StereoSGBM leaves the left min_d + num_d columns without a result; pad
+  // both images on the left so that every real column gets one.
+  const int pad = std::max(0, min_d + num_d);
+  cv::Mat lp, rp, d16, d, xyz;
+  cv::copyMakeBorder(lr, lp, 0, 0, pad, 0, cv::BORDER_REPLICATE);
+  cv::copyMakeBorder(rr, rp, 0, 0, pad, 0, cv::BORDER_REPLICATE);
+  Make(options, min_d, num_d)->compute(lp, rp, d16);
+  d16(cv::Rect(pad, 0, size.width, size.height)).convertTo(d, CV_32F, 1.0 / 16);
   cv::reprojectImageTo3D(d, xyz, q, true);
   // Back to the unrectified left view: rectified pixel of each left pixel,
   // then the point, rotated from the rectified frame into the left camera.

@@ -1,0 +1,30 @@
+// fovea report: one self-contained HTML page (pictures embedded, plots drawn
+// by gnuplot as inline SVG) for a run folder or a sweep folder.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace experiments {
+
+/// One curve of a plot: a title and its points.
+struct Series {
+  explicit Series(std::string title_) : title(std::move(title_)) {}
+  std::string title;
+  std::vector<double> x, y;
+  std::vector<double> y_lo, y_hi;  ///< optional error bars (same length as y)
+  bool dashed = false;
+};
+
+/// A plot drawn by gnuplot (`gnuplot` on the PATH) as SVG text. Throws
+/// std::runtime_error when gnuplot is missing or fails.
+std::string GnuplotSvg(const std::string& title, const std::string& xlabel, const std::string& ylabel,
+                       const std::vector<Series>& series, bool log_y = false);
+
+/// Writes DIR/report.html for a run folder (summary.json) or a sweep folder
+/// (grid.json and results.csv); returns its path. Throws UsageError when DIR
+/// is neither.
+std::string WriteReport(const std::string& dir);
+
+}  // namespace experiments
