@@ -193,8 +193,10 @@ int RunSweep(const SweepArgs& args) {
     std::fprintf(stderr, "fovea sweep: %zu runs -> %s/results.csv%s\n", sweep.runs.size(), dir.c_str(),
                  args.no_report ? "" : (", " + dir + "/report.html").c_str());
   else if (failed.empty())
-    std::fprintf(stderr, "fovea sweep: shard %s done; %zu runs of the sweep still to come (fovea collect %s when all shards are done)\n",
-                 args.shard.c_str(), missing.size(), dir.c_str());
+    std::fprintf(stderr,
+                 "fovea sweep: shard %s done; %zu runs of the sweep are in other shards (merge with fovea collect "
+                 "OUT SHARD_FOLDER... when all are done)\n",
+                 args.shard.c_str(), missing.size());
   return failed.empty() ? 0 : 1;
 }
 
