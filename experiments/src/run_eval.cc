@@ -64,7 +64,7 @@ MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref, const si
   std::array<Accumulator, 3> level;
   struct PerSurface {
     long pixels = 0, mapped = 0, foveal = 0;
-    std::vector<double> abs;
+    Accumulator errors;
   };
   std::map<int, PerSurface> surfaces;
   long mapped = 0, foveal = 0;
@@ -84,7 +84,7 @@ MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref, const si
       const double step = zt * zt / (f * baseline_m);
       all.Add(z, zt, step);
       level[lv].Add(z, zt, step);
-      ps.abs.push_back(std::abs(z - zt));
+      ps.errors.Add(z, zt, step);
     }
   const long total = ref.textured_pixels;
   s.coverage = total ? double(mapped) / total : 0;
@@ -97,7 +97,11 @@ MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref, const si
     sf.pixels = ps.pixels;
     sf.coverage = double(ps.mapped) / ps.pixels;
     sf.foveal_coverage = double(ps.foveal) / ps.pixels;
-    sf.median_abs_error_m = Quantile(ps.abs, 0.5);
+    const ErrorFigures e = ps.errors.Figures(ps.pixels);
+    sf.median_abs_error_m = e.median_abs_error_m;
+    sf.median_rel_error = e.median_rel_error;
+    sf.median_error_steps = e.median_error_steps;
+    sf.rmse_m = e.rmse_m;
     s.surfaces.push_back(sf);
   }
   if (per_patch) {
@@ -148,7 +152,10 @@ nlohmann::json ScoreJson(const MapScore& s) {
     j["by_surface"][sf.name] = {{"pixels", sf.pixels},
                                 {"coverage", sf.coverage},
                                 {"foveal_coverage", sf.foveal_coverage},
-                                {"median_abs_error_m", sf.median_abs_error_m}};
+                                {"median_abs_error_m", sf.median_abs_error_m},
+                                {"median_rel_error", sf.median_rel_error},
+                                {"median_error_steps", sf.median_error_steps},
+                                {"rmse_m", sf.rmse_m}};
   if (s.has_patch_error)
     j["patch_3d_error"] = {{"patches", s.patches_scored},
                            {"median_m", s.patch_error_median_m},

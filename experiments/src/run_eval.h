@@ -37,7 +37,8 @@ struct ErrorFigures {
 struct SurfaceFigures {
   std::string name;
   long pixels = 0;                 ///< visible textured pixels of the surface
-  double coverage = 0, foveal_coverage = 0, median_abs_error_m = 0;
+  double coverage = 0, foveal_coverage = 0;
+  double median_abs_error_m = 0, median_rel_error = 0, median_error_steps = 0, rmse_m = 0;  ///< 0 when unmapped
 };
 
 struct MapScore {

@@ -155,7 +155,7 @@ Sweep LoadSweep(const std::string& path) {
       } catch (const UsageError& e) {
         throw UsageError(where + "axes: " + e.what());
       }
-      if (axis.path == "scene") CheckScene(v, where + "axes: ");
+      if (axis.path == "scene") CheckScene(v, where + "axes: key 'scene': ");
     }
     for (const SweepAxis& a : sweep.axes)
       if (a.path == axis.path) throw UsageError(where + "axes: key '" + axis.path + "' appears twice");
@@ -191,7 +191,7 @@ Sweep LoadSweep(const std::string& path) {
     SweepRun run{ConfigHash(config), Variant(config), config, point};
     if (seen.insert(run.id).second) sweep.runs.push_back(std::move(run));
   };
-  CheckScene(base.scene, where);
+  CheckScene(base.scene, where + "key 'scene': ");
   std::vector<std::vector<std::pair<std::string, std::string>>> points;
   std::vector<size_t> index(sweep.axes.size(), 0);
   for (long i = 0; i < total; ++i) {
