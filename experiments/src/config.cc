@@ -159,18 +159,21 @@ void Walk(const YAML::Node& node, const std::string& prefix, std::map<std::strin
 }
 }  // namespace
 
-RunConfig LoadConfig(const std::string& path) {
-  const std::string where = "config " + path + ": ";
+YAML::Node LoadYamlFile(const std::string& path, const std::string& where) {
   std::ifstream in(path);
   if (!in) throw UsageError(where + "cannot read the file");
   std::stringstream text;
   text << in.rdbuf();
-  YAML::Node root;
   try {
-    root = YAML::Load(text.str());
+    return YAML::Load(text.str());
   } catch (const YAML::Exception& e) {
     throw UsageError(where + "not valid YAML (line " + std::to_string(e.mark.line + 1) + ": " + e.msg + ")");
   }
+}
+
+RunConfig LoadConfig(const std::string& path) {
+  const std::string where = "config " + path + ": ";
+  const YAML::Node root = LoadYamlFile(path, where);
   RunConfig config;
   ApplyYaml(root, &config, where);
   try {

@@ -74,6 +74,10 @@ std::string ConfigHash(const RunConfig& config);
 /// The value of one parameter as text (as written in the YAML file).
 std::string ParamText(RunConfig* config, const std::string& path);
 
+/// Parses a YAML file; throws UsageError prefixed with `where` when it cannot
+/// be read or is not YAML (with the line).
+YAML::Node LoadYamlFile(const std::string& path, const std::string& where);
+
 /// Reads the keys of a YAML mapping over `config` (as LoadConfig does for a
 /// file); `where` prefixes every error message.
 void ApplyYaml(const YAML::Node& root, RunConfig* config, const std::string& where);

@@ -98,16 +98,7 @@ bool ConcernsStatic(const std::string& path) {
 
 Sweep LoadSweep(const std::string& path) {
   const std::string where = "sweep " + path + ": ";
-  std::ifstream in(path);
-  if (!in) throw UsageError(where + "cannot read the file");
-  std::stringstream text;
-  text << in.rdbuf();
-  YAML::Node root;
-  try {
-    root = YAML::Load(text.str());
-  } catch (const YAML::Exception& e) {
-    throw UsageError(where + "not valid YAML (line " + std::to_string(e.mark.line + 1) + ": " + e.msg + ")");
-  }
+  const YAML::Node root = LoadYamlFile(path, where);
   if (!root.IsMap()) throw UsageError(where + "expected a mapping with base, config, axes, baselines, jobs");
   Sweep sweep;
   sweep.file = path;
