@@ -15,5 +15,6 @@ void AddIdrCommand(CLI::App& app, std::function<int()>* run);
 void AddFixateCommand(CLI::App& app, std::function<int()>* run);
 void AddRunCommand(CLI::App& app, std::function<int()>* run);
 void AddSweepCommands(CLI::App& app, std::function<int()>* run);
+void AddHardwareCommands(CLI::App& app, std::function<int()>* run);
 
 }  // namespace experiments

@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   experiments::AddFixateCommand(app, &run);
   experiments::AddRunCommand(app, &run);
   experiments::AddSweepCommands(app, &run);
+  experiments::AddHardwareCommands(app, &run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
