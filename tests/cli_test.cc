@@ -192,3 +192,39 @@ TEST_CASE("bad sweep files each give one line naming the key, exit 2 and no outp
   }
   fs::remove_all(dir);
 }
+
+TEST_CASE("hardware rig setup errors are one line, non-zero exit and no output", "[cli][hardware]") {
+  const fs::path out = TempDir("hw_bad");
+  const fs::path dir = TempDir("hw");
+  fs::create_directories(dir);
+  const std::string configs = std::string(FOVEA_SCENES_DIR) + "/../experiments/configs";
+  const std::string base = "run --config " + configs + "/emulated-hardware.yaml --set rig.calibration=" + configs +
+                           "/emulated-hardware-calibration.yaml";
+  // A calibration for another image size.
+  std::ofstream(dir / "small.yaml") << "%YAML:1.0\n---\nleft: {width_px: 320, height_px: 240, fx_px: 600., fy_px: 600., "
+                                       "cx_px: 159.5, cy_px: 119.5}\nright: {width_px: 320, height_px: 240, fx_px: 600., "
+                                       "fy_px: 600., cx_px: 159.5, cy_px: 119.5}\n";
+  std::ofstream(dir / "broken.yaml") << "%YAML:1.0\n---\nleft: {width_px: 640}\n";
+  struct Case {
+    std::string args, expect;
+  };
+  const std::vector<Case> cases = {
+      {base + " --set rig.emulate_stages=false --set rig.port=/dev/ttyNOPE0", "serial port '/dev/ttyNOPE0' does not exist"},
+      {base + " --set rig.baud=12345", "baud rate 12345"},
+      {base + " --set rig.left_camera=/nonexistent/left_%05d.png", "camera '/nonexistent/left_%05d.png' cannot be opened"},
+      {base + " --set rig.calibration=" + (dir / "small.yaml").string(), "is for 320x240 images"},
+      {base + " --set rig.calibration=" + (dir / "broken.yaml").string(), "missing number 'height_px'"},
+      {base + " --set rig.calibration=/nonexistent/calibration.yaml", "cannot be read"},
+      {base + " --set rig.emulate_stages=false", "key 'rig.port'"},
+  };
+  for (const Case& c : cases) {
+    const Result r = Fovea(c.args + " --out " + out.string());
+    INFO(c.args << " -> exit " << r.exit_code << ": " << r.err);
+    CHECK(r.exit_code != 0);
+    CHECK(r.exit_code < 128);
+    CHECK(Lines(r.err) == 1);
+    CHECK(r.err.find(c.expect) != std::string::npos);
+    CHECK_FALSE(fs::exists(out));
+  }
+  fs::remove_all(dir);
+}

@@ -90,6 +90,17 @@ std::vector<ConfigParam> ConfigParams(RunConfig* c) {
       {"rig.tilt_limit_deg", "tilt axes: symmetric travel limit, degrees", &c->rig.tilt_limit_deg, 1, 89},
       {"rig.baseline_steps_per_mm", "baseline axes: motor steps per millimetre", &c->rig.baseline_steps_per_mm, 1, 1e6},
       {"rig.pan_tilt_steps_per_deg", "pan and tilt axes: motor steps per degree", &c->rig.pan_tilt_steps_per_deg, 1, 1e6},
+      {"rig.type", "sim: the simulated TAVT; hardware: serial stages and cameras (the keys below)", &c->hardware.type, 0, 0, {"sim", "hardware"}},
+      {"rig.port", "hardware: the stages' serial port (e.g. /dev/ttyUSB0)", &c->hardware.port},
+      {"rig.baud", "hardware: the serial port's baud rate", &c->hardware.baud, 1200, 230400},
+      {"rig.emulate_stages", "hardware: drive the indexer emulator (a pseudo-terminal in this process) instead of rig.port", &c->hardware.emulate_stages},
+      {"rig.left_camera", "hardware: left camera: V4L2 index or path, video file, or image sequence (rec/left_%05d.png)", &c->hardware.left_camera},
+      {"rig.right_camera", "hardware: right camera, as rig.left_camera", &c->hardware.right_camera},
+      {"rig.calibration", "hardware: calibration file (fovea calibrate, or OpenCV YAML by hand)", &c->hardware.calibration},
+      {"rig.frame_timeout_s", "hardware: longest wait for a camera frame, seconds", &c->hardware.frame_timeout_s, 0.01, 60},
+      {"rig.baseline_velocity_m_s", "hardware: baseline axes' speed, metres per second (acceleration 10x per second)", &c->hardware.baseline_velocity_m_s, 1e-4, 1},
+      {"rig.pan_tilt_velocity_rad_s", "hardware: pan and tilt axes' speed, radians per second (acceleration 10x per second)", &c->hardware.pan_tilt_velocity_rad_s, 1e-3, 10},
+      {"rig.record_dir", "sim: also write every capture to this folder (left_NNNNN.png, right_NNNNN.png) for replay", &c->rig.record_dir},
       {"rig.noise_sigma_dn", "sensor read noise, grey levels (0 = off)", &c->rig.noise.read_noise_sigma_dn, 0, 50},
       {"rig.blur_sigma_px", "optical blur before the noise, pixels (0 = off)", &c->rig.noise.blur_sigma_px, 0, 10},
       {"loop.fixations", "successful fixations to make", &f.fixations, 1, 10000},
@@ -205,6 +216,13 @@ void RunConfig::Check() const {
     r.Check();
   } catch (const sim::SceneError& e) {
     throw UsageError(e.what());
+  }
+  if (hardware.type == "hardware") {
+    if (hardware.port.empty() && !hardware.emulate_stages)
+      throw UsageError("key 'rig.port': a hardware rig needs the stages' serial port (or rig.emulate_stages: true)");
+    if (hardware.left_camera.empty()) throw UsageError("key 'rig.left_camera': a hardware rig needs a left camera");
+    if (hardware.right_camera.empty()) throw UsageError("key 'rig.right_camera': a hardware rig needs a right camera");
+    if (hardware.calibration.empty()) throw UsageError("key 'rig.calibration': a hardware rig needs a calibration file");
   }
   const double widest = 2 * rig.carriage_max_m;
   if (rig.home_baseline_m > widest)

@@ -24,6 +24,19 @@ struct RunConfig {
   std::string method = "fovea";
   std::string matcher = "nl1";       ///< per-level matcher of the foveated stage
   sim::SimRigConfig rig;             ///< the simulated rig (its seed is `seed`)
+  /// The real rig (rig.type: hardware): stages on a serial port (or the
+  /// in-process emulator), two cameras, a calibration file. Axis limits and
+  /// steps per unit are the rig.* ones above.
+  struct Hardware {
+    std::string type = "sim";
+    std::string port;
+    int baud = 9600;
+    bool emulate_stages = false;
+    std::string left_camera, right_camera, calibration;
+    double frame_timeout_s = 2;
+    double baseline_velocity_m_s = 0.05;
+    double pan_tilt_velocity_rad_s = 1.0;
+  } hardware;
   double static_baseline_m = 0;      ///< static_sgbm's baseline; 0 = the widest useful
   fovea::FoveaOptions fovea;
 

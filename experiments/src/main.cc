@@ -2,12 +2,16 @@
 #include <cstdio>
 #include <exception>
 
+#include <opencv2/core/utils/logger.hpp>
+
 #include "commands.h"
 #include "output.h"
 #include "rig/types.h"
 #include "sim/config.h"
 
 int main(int argc, char** argv) {
+  // Errors reach the user as one line of ours, not as OpenCV's own log.
+  cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
   CLI::App app{"fovea: a foveated vergent active stereo testbed (Klarquist & Bovik 1998)"};
   app.require_subcommand(1);
   std::function<int()> run;

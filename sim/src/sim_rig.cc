@@ -1,6 +1,8 @@
 #include "sim/sim_rig.h"
 
 #include <cmath>
+#include <cstdio>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "world.h"
@@ -139,6 +141,15 @@ rig::StereoFrame SimRig::Capture(const rig::CaptureOptions& options) {
     }
     view.intrinsics = Intrinsics(side);
     view.world_T_camera = CameraPoseFromMujoco(world_->d, world_->camera_ids[s]);
+    if (!config_.record_dir.empty()) {
+      // Numbered from 0 in capture order: OpenCV's image-sequence reader
+      // (and a HardwareRig camera) replays them.
+      char name[64];
+      std::snprintf(name, sizeof name, "/%s_%05llu.png", s == 0 ? "left" : "right",
+                    static_cast<unsigned long long>(capture_count_ - 1));
+      if (!cv::imwrite(config_.record_dir + name, view.gray))
+        throw rig::RigError("cannot record a capture to '" + config_.record_dir + name + "'");
+    }
   }
   return frame;
 }

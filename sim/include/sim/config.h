@@ -54,6 +54,11 @@ struct SimRigConfig {
   NoiseConfig noise;
   uint64_t seed = 0;  ///< seeds the sensor noise
 
+  /// When set, every capture's grey images are also written to this folder
+  /// as left_NNNNN.png / right_NNNNN.png in capture order (for replaying a
+  /// session through a HardwareRig's cameras).
+  std::string record_dir;
+
   /// Throws SceneError naming the first invalid field.
   void Check() const;
 };

@@ -1,0 +1,163 @@
+#include "rig/hardware_rig.h"
+
+#include <filesystem>
+#include <future>
+#include <unistd.h>
+#include <opencv2/imgproc.hpp>
+
+namespace rig {
+
+CameraSource::CameraSource(const std::string& spec, int width_px, int height_px, std::chrono::milliseconds timeout)
+    : spec_(spec), width_px_(width_px), height_px_(height_px), timeout_(timeout) {
+  const bool index = !spec.empty() && spec.find_first_not_of("0123456789") == std::string::npos;
+  const bool sequence = spec.find('%') != std::string::npos;
+  // What does not exist is said plainly (and the video backends, which log
+  // on their own, are not asked).
+  const std::string must_exist = sequence ? std::filesystem::path(spec).parent_path().string() : spec;
+  if (!index && !must_exist.empty() && !std::filesystem::exists(must_exist))
+    throw RigError("camera '" + spec + "' cannot be opened: no such " + (sequence ? "folder" : "file or device"));
+  bool ok = false;
+  try {
+    ok = index ? capture_.open(std::stoi(spec), cv::CAP_V4L2)
+               : capture_.open(spec, sequence ? cv::CAP_IMAGES : cv::CAP_ANY);
+  } catch (const cv::Exception&) {
+    ok = false;
+  }
+  if (!ok || !capture_.isOpened()) throw RigError("camera '" + spec + "' cannot be opened");
+  if (index) {
+    capture_.set(cv::CAP_PROP_FRAME_WIDTH, width_px);
+    capture_.set(cv::CAP_PROP_FRAME_HEIGHT, height_px);
+  }
+  // Check the size before the first frame is taken (a source that does not
+  // tell is checked at every Grab).
+  const int w = static_cast<int>(capture_.get(cv::CAP_PROP_FRAME_WIDTH));
+  const int h = static_cast<int>(capture_.get(cv::CAP_PROP_FRAME_HEIGHT));
+  if (w > 0 && h > 0 && (w != width_px || h != height_px))
+    throw RigError("camera '" + spec + "' gives " + std::to_string(w) + "x" + std::to_string(h) +
+                   " images, the calibration is for " + std::to_string(width_px) + "x" + std::to_string(height_px));
+}
+
+cv::Mat CameraSource::Grab() {
+  // VideoCapture::read blocks on a device that sends nothing: read on a
+  // worker and give up after the timeout.
+  auto frame = std::make_shared<cv::Mat>();
+  auto read = std::async(std::launch::async, [this, frame] { return capture_.read(*frame); });
+  if (read.wait_for(timeout_) != std::future_status::ready)
+    throw RigError("camera '" + spec_ + "': no frame within " + std::to_string(timeout_.count()) + " ms");
+  if (!read.get() || frame->empty()) throw RigError("camera '" + spec_ + "': no more frames");
+  if (frame->cols != width_px_ || frame->rows != height_px_)
+    throw RigError("camera '" + spec_ + "' gives " + std::to_string(frame->cols) + "x" + std::to_string(frame->rows) +
+                   " images, the calibration is for " + std::to_string(width_px_) + "x" + std::to_string(height_px_));
+  cv::Mat gray;
+  if (frame->channels() == 3) cv::cvtColor(*frame, gray, cv::COLOR_BGR2GRAY);
+  else if (frame->channels() == 4) cv::cvtColor(*frame, gray, cv::COLOR_BGRA2GRAY);
+  else gray = *frame;
+  return gray;
+}
+
+namespace {
+
+void WriteCamera(cv::FileStorage& fs, const char* name, const CameraIntrinsics& k, const Eigen::Vector3d& offset) {
+  fs << name << "{";
+  fs << "width_px" << k.width_px << "height_px" << k.height_px;
+  fs << "fx_px" << k.fx_px << "fy_px" << k.fy_px << "cx_px" << k.cx_px << "cy_px" << k.cy_px;
+  fs << "distortion" << k.distortion;
+  fs << "optical_centre_H_m" << std::vector<double>{offset.x(), offset.y(), offset.z()};
+  fs << "}";
+}
+
+void ReadCamera(const cv::FileStorage& fs, const std::string& path, const char* name, CameraIntrinsics* k,
+                Eigen::Vector3d* offset) {
+  const cv::FileNode n = fs[name];
+  auto fail = [&](const std::string& what) {
+    throw RigError("calibration " + path + ": " + name + ": " + what);
+  };
+  if (n.empty() || !n.isMap()) fail("missing");
+  for (const char* key : {"width_px", "height_px", "fx_px", "fy_px", "cx_px", "cy_px"})
+    if (n[key].empty() || (!n[key].isReal() && !n[key].isInt())) fail(std::string("missing number '") + key + "'");
+  k->width_px = static_cast<int>(n["width_px"]);
+  k->height_px = static_cast<int>(n["height_px"]);
+  k->fx_px = static_cast<double>(n["fx_px"]);
+  k->fy_px = static_cast<double>(n["fy_px"]);
+  k->cx_px = static_cast<double>(n["cx_px"]);
+  k->cy_px = static_cast<double>(n["cy_px"]);
+  k->distortion.clear();
+  if (!n["distortion"].empty()) n["distortion"] >> k->distortion;
+  std::vector<double> o;
+  if (!n["optical_centre_H_m"].empty()) n["optical_centre_H_m"] >> o;
+  if (!o.empty() && o.size() != 3) fail("optical_centre_H_m needs 3 numbers");
+  *offset = o.empty() ? Eigen::Vector3d::Zero() : Eigen::Vector3d(o[0], o[1], o[2]);
+  try {
+    k->Check();
+  } catch (const RigError& e) {
+    fail(e.what());
+  }
+}
+
+}  // namespace
+
+RigCalibration LoadCalibration(const std::string& path) {
+  if (::access(path.c_str(), R_OK) != 0) throw RigError("calibration " + path + ": cannot be read");
+  cv::FileStorage fs;
+  try {
+    fs.open(path, cv::FileStorage::READ);
+  } catch (const cv::Exception&) {
+  }
+  if (!fs.isOpened()) throw RigError("calibration " + path + ": cannot be read");
+  RigCalibration c;
+  ReadCamera(fs, path, "left", &c.left, &c.left_optical_centre_H);
+  ReadCamera(fs, path, "right", &c.right, &c.right_optical_centre_H);
+  return c;
+}
+
+void SaveCalibration(const std::string& path, const RigCalibration& c) {
+  cv::FileStorage fs(path, cv::FileStorage::WRITE);
+  if (!fs.isOpened()) throw RigError("calibration " + path + ": cannot be written");
+  WriteCamera(fs, "left", c.left, c.left_optical_centre_H);
+  WriteCamera(fs, "right", c.right, c.right_optical_centre_H);
+}
+
+HardwareRig::HardwareRig(HardwareRigConfig config) : calibration_(config.calibration) {
+  for (int i = 0; i < kNumAxes; ++i) {
+    const IndexerAxis& a = config.stages.axes[i];
+    limits_.axes[i] = {a.min, a.max, a.steps_per_unit};
+  }
+  geometry_.left.optical_centre_H = calibration_.left_optical_centre_H;
+  geometry_.right.optical_centre_H = calibration_.right_optical_centre_H;
+  home_ = limits_.Quantize(StageState::Parallel(config.home_baseline_m));
+  left_ = std::make_unique<CameraSource>(config.left_camera, calibration_.left.width_px, calibration_.left.height_px,
+                                         config.frame_timeout);
+  right_ = std::make_unique<CameraSource>(config.right_camera, calibration_.right.width_px,
+                                          calibration_.right.height_px, config.frame_timeout);
+  driver_ = std::make_unique<IndexerDriver>(std::move(config.line), config.stages);
+  state_ = driver_->Position();
+}
+
+MoveResult HardwareRig::MoveTo(const StageState& target) {
+  const std::string violation = limits_.Violation(target);
+  if (!violation.empty()) throw RigError("move refused: " + violation);
+  MoveResult r = driver_->MoveTo(limits_.Quantize(target));
+  state_ = r.reached;
+  return r;
+}
+
+StageState HardwareRig::State() const { return state_; }
+
+CameraIntrinsics HardwareRig::Intrinsics(Side side) const {
+  return side == Side::kLeft ? calibration_.left : calibration_.right;
+}
+
+StereoFrame HardwareRig::Capture(const CaptureOptions&) {
+  StereoFrame frame;
+  frame.state = state_;
+  frame.timestamp_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  for (const Side side : {Side::kLeft, Side::kRight}) {
+    CameraView& view = side == Side::kLeft ? frame.left : frame.right;
+    view.gray = (side == Side::kLeft ? left_ : right_)->Grab();
+    view.intrinsics = Intrinsics(side);
+    view.world_T_camera = geometry_.WorldFromCamera(side, state_[side]);
+  }
+  return frame;
+}
+
+}  // namespace rig
