@@ -16,5 +16,6 @@ void AddFixateCommand(CLI::App& app, std::function<int()>* run);
 void AddRunCommand(CLI::App& app, std::function<int()>* run);
 void AddSweepCommands(CLI::App& app, std::function<int()>* run);
 void AddHardwareCommands(CLI::App& app, std::function<int()>* run);
+void AddCalibrateCommands(CLI::App& app, std::function<int()>* run);
 
 }  // namespace experiments

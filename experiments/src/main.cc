@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   experiments::AddRunCommand(app, &run);
   experiments::AddSweepCommands(app, &run);
   experiments::AddHardwareCommands(app, &run);
+  experiments::AddCalibrateCommands(app, &run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -111,7 +111,7 @@ RigCalibration LoadCalibration(const std::string& path) {
 }
 
 void SaveCalibration(const std::string& path, const RigCalibration& c) {
-  cv::FileStorage fs(path, cv::FileStorage::WRITE);
+  cv::FileStorage fs(path, cv::FileStorage::WRITE | cv::FileStorage::FORMAT_YAML);
   if (!fs.isOpened()) throw RigError("calibration " + path + ": cannot be written");
   WriteCamera(fs, "left", c.left, c.left_optical_centre_H);
   WriteCamera(fs, "right", c.right, c.right_optical_centre_H);
