@@ -1,8 +1,11 @@
 #include "rig/hardware_rig.h"
 
 #include <filesystem>
+#include <algorithm>
 #include <future>
+#include <thread>
 #include <unistd.h>
+#include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
 namespace rig {
@@ -18,32 +21,39 @@ CameraSource::CameraSource(const std::string& spec, int width_px, int height_px,
     throw RigError("camera '" + spec + "' cannot be opened: no such " + (sequence ? "folder" : "file or device"));
   bool ok = false;
   try {
-    ok = index ? capture_.open(std::stoi(spec), cv::CAP_V4L2)
-               : capture_.open(spec, sequence ? cv::CAP_IMAGES : cv::CAP_ANY);
+    ok = index ? capture_->open(std::stoi(spec), cv::CAP_V4L2)
+               : capture_->open(spec, sequence ? cv::CAP_IMAGES : cv::CAP_ANY);
   } catch (const cv::Exception&) {
     ok = false;
   }
-  if (!ok || !capture_.isOpened()) throw RigError("camera '" + spec + "' cannot be opened");
+  if (!ok || !capture_->isOpened()) throw RigError("camera '" + spec + "' cannot be opened");
   if (index) {
-    capture_.set(cv::CAP_PROP_FRAME_WIDTH, width_px);
-    capture_.set(cv::CAP_PROP_FRAME_HEIGHT, height_px);
+    capture_->set(cv::CAP_PROP_FRAME_WIDTH, width_px);
+    capture_->set(cv::CAP_PROP_FRAME_HEIGHT, height_px);
   }
   // Check the size before the first frame is taken (a source that does not
   // tell is checked at every Grab).
-  const int w = static_cast<int>(capture_.get(cv::CAP_PROP_FRAME_WIDTH));
-  const int h = static_cast<int>(capture_.get(cv::CAP_PROP_FRAME_HEIGHT));
+  const int w = static_cast<int>(capture_->get(cv::CAP_PROP_FRAME_WIDTH));
+  const int h = static_cast<int>(capture_->get(cv::CAP_PROP_FRAME_HEIGHT));
   if (w > 0 && h > 0 && (w != width_px || h != height_px))
     throw RigError("camera '" + spec + "' gives " + std::to_string(w) + "x" + std::to_string(h) +
                    " images, the calibration is for " + std::to_string(width_px) + "x" + std::to_string(height_px));
 }
 
 cv::Mat CameraSource::Grab() {
+  if (stalled_) throw RigError("camera '" + spec_ + "': stalled earlier (no frame within the timeout)");
   // VideoCapture::read blocks on a device that sends nothing: read on a
-  // worker and give up after the timeout.
+  // detached worker (which owns what it touches) and give up after the
+  // timeout; a promise's future, unlike std::async's, does not wait for the
+  // worker when it goes away.
   auto frame = std::make_shared<cv::Mat>();
-  auto read = std::async(std::launch::async, [this, frame] { return capture_.read(*frame); });
-  if (read.wait_for(timeout_) != std::future_status::ready)
+  auto done = std::make_shared<std::promise<bool>>();
+  std::future<bool> read = done->get_future();
+  std::thread([capture = capture_, frame, done] { done->set_value(capture->read(*frame)); }).detach();
+  if (read.wait_for(timeout_) != std::future_status::ready) {
+    stalled_ = true;
     throw RigError("camera '" + spec_ + "': no frame within " + std::to_string(timeout_.count()) + " ms");
+  }
   if (!read.get() || frame->empty()) throw RigError("camera '" + spec_ + "': no more frames");
   if (frame->cols != width_px_ || frame->rows != height_px_)
     throw RigError("camera '" + spec_ + "' gives " + std::to_string(frame->cols) + "x" + std::to_string(frame->rows) +
@@ -144,7 +154,9 @@ MoveResult HardwareRig::MoveTo(const StageState& target) {
 StageState HardwareRig::State() const { return state_; }
 
 CameraIntrinsics HardwareRig::Intrinsics(Side side) const {
-  return side == Side::kLeft ? calibration_.left : calibration_.right;
+  CameraIntrinsics k = side == Side::kLeft ? calibration_.left : calibration_.right;
+  k.distortion.clear();  // Capture undistorts
+  return k;
 }
 
 StereoFrame HardwareRig::Capture(const CaptureOptions&) {
@@ -153,7 +165,13 @@ StereoFrame HardwareRig::Capture(const CaptureOptions&) {
   frame.timestamp_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   for (const Side side : {Side::kLeft, Side::kRight}) {
     CameraView& view = side == Side::kLeft ? frame.left : frame.right;
-    view.gray = (side == Side::kLeft ? left_ : right_)->Grab();
+    const cv::Mat raw = (side == Side::kLeft ? left_ : right_)->Grab();
+    // Frames go out undistorted, with the same pinhole intrinsics.
+    const CameraIntrinsics& k = side == Side::kLeft ? calibration_.left : calibration_.right;
+    if (std::any_of(k.distortion.begin(), k.distortion.end(), [](double d) { return d != 0; }))
+      cv::undistort(raw, view.gray, cv::Mat(k.K()), k.distortion);
+    else
+      view.gray = raw;
     view.intrinsics = Intrinsics(side);
     view.world_T_camera = geometry_.WorldFromCamera(side, state_[side]);
   }

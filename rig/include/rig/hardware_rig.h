@@ -21,8 +21,8 @@ class CameraSource {
   /// Throws RigError naming the source when it cannot be opened.
   CameraSource(const std::string& spec, int width_px, int height_px, std::chrono::milliseconds timeout);
   /// The next frame, CV_8UC1. Throws RigError when none comes within the
-  /// timeout, when the source has ended, or when its size is not the
-  /// calibrated one.
+  /// timeout (the source is then given up), when the source has ended, or
+  /// when its size is not the calibrated one.
   cv::Mat Grab();
   const std::string& spec() const { return spec_; }
 
@@ -30,7 +30,8 @@ class CameraSource {
   std::string spec_;
   int width_px_, height_px_;
   std::chrono::milliseconds timeout_;
-  cv::VideoCapture capture_;
+  std::shared_ptr<cv::VideoCapture> capture_ = std::make_shared<cv::VideoCapture>();
+  bool stalled_ = false;
 };
 
 /// What a calibration file holds (OpenCV FileStorage YAML, written by
