@@ -216,6 +216,8 @@ TEST_CASE("hardware rig setup errors are one line, non-zero exit and no output",
       {base + " --set rig.calibration=" + (dir / "broken.yaml").string(), "missing number 'height_px'"},
       {base + " --set rig.calibration=/nonexistent/calibration.yaml", "cannot be read"},
       {base + " --set rig.emulate_stages=false", "key 'rig.port'"},
+      {base + " --set rig.units=1,2,3,4,5,5", "key 'rig.units': address 5 appears twice"},
+      {base + " --set rig.directions=1,1,1,1,2,1", "key 'rig.directions'"},
       {"calibrate --left '/nonexistent/*.png' --right '/nonexistent/*.png' --board 9x6 --square 0.025", "no files match"},
       {"calibrate --left '/nonexistent/*.png' --right '/nonexistent/*.png' --board 9by6 --square 0.025", "--board expects WxH"},
   };

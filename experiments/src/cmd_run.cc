@@ -183,8 +183,9 @@ int RunStatic(const RunConfig& config, const std::string& out, Clock::time_point
 }
 
 // The real rig of rig.type: hardware: stages on rig.port (or on the indexer
-// emulator, started here), cameras and calibration from the config; axes
-// 1 to 6 in rig::Axis order, limits and steps from the rig.* keys.
+// emulator, started here), cameras and calibration from the config; unit
+// addresses and directions from rig.units / rig.directions, limits and steps
+// from the rig.* keys.
 std::unique_ptr<rig::HardwareRig> MakeHardwareRig(const RunConfig& c, std::unique_ptr<rig::IndexerEmulator>* emulator) {
   const RunConfig::Hardware& h = c.hardware;
   rig::HardwareRigConfig hw;
@@ -196,10 +197,12 @@ std::unique_ptr<rig::HardwareRig> MakeHardwareRig(const RunConfig& c, std::uniqu
                           std::to_string(c.rig.width_px) + "x" + std::to_string(c.rig.height_px));
   const double lin = c.rig.baseline_steps_per_mm * 1000, ang = c.rig.pan_tilt_steps_per_deg * 180 / M_PI;
   const double pan = c.rig.pan_limit_deg * M_PI / 180, tilt = c.rig.tilt_limit_deg * M_PI / 180;
+  const auto units = SixInts(h.units, "rig.units"), directions = SixInts(h.directions, "rig.directions");
   for (int i = 0; i < rig::kNumAxes; ++i) {
     rig::IndexerAxis& a = hw.stages.axes[i];
     const auto axis = static_cast<rig::Axis>(i);
-    a.unit = i + 1;
+    a.unit = units[i];
+    a.sign = directions[i];
     const bool baseline = axis == rig::Axis::kLeftBaseline || axis == rig::Axis::kRightBaseline;
     a.steps_per_unit = baseline ? lin : ang;
     a.velocity = baseline ? h.baseline_velocity_m_s : h.pan_tilt_velocity_rad_s;
@@ -211,7 +214,7 @@ std::unique_ptr<rig::HardwareRig> MakeHardwareRig(const RunConfig& c, std::uniqu
   }
   std::string port = h.port;
   if (h.emulate_stages) {
-    *emulator = std::make_unique<rig::IndexerEmulator>(std::vector<int>{1, 2, 3, 4, 5, 6});
+    *emulator = std::make_unique<rig::IndexerEmulator>(std::vector<int>(units.begin(), units.end()));
     port = (*emulator)->Path();
   }
   hw.line = rig::OpenSerialPort(port, h.baud);

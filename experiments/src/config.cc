@@ -94,6 +94,8 @@ std::vector<ConfigParam> ConfigParams(RunConfig* c) {
       {"rig.port", "hardware: the stages' serial port (e.g. /dev/ttyUSB0)", &c->hardware.port},
       {"rig.baud", "hardware: the serial port's baud rate", &c->hardware.baud, 1200, 230400},
       {"rig.emulate_stages", "hardware: drive the indexer emulator (a pseudo-terminal in this process) instead of rig.port", &c->hardware.emulate_stages},
+      {"rig.units", "hardware: indexer unit addresses of the six axes (left baseline, pan, tilt, right baseline, pan, tilt)", &c->hardware.units},
+      {"rig.directions", "hardware: motor direction of each axis against the rig's convention, +1 or -1, same order", &c->hardware.directions},
       {"rig.left_camera", "hardware: left camera: V4L2 index or path, video file, or image sequence (rec/left_%05d.png)", &c->hardware.left_camera},
       {"rig.right_camera", "hardware: right camera, as rig.left_camera", &c->hardware.right_camera},
       {"rig.calibration", "hardware: calibration file (fovea calibrate, or OpenCV YAML by hand)", &c->hardware.calibration},
@@ -217,6 +219,14 @@ void RunConfig::Check() const {
   } catch (const sim::SceneError& e) {
     throw UsageError(e.what());
   }
+  const auto units = SixInts(hardware.units, "rig.units");
+  for (int i = 0; i < 6; ++i) {
+    if (units[i] < 1 || units[i] > 99) throw UsageError("key 'rig.units': addresses must be 1 to 99");
+    for (int j = 0; j < i; ++j)
+      if (units[j] == units[i]) throw UsageError("key 'rig.units': address " + std::to_string(units[i]) + " appears twice");
+  }
+  for (const int d : SixInts(hardware.directions, "rig.directions"))
+    if (d != 1 && d != -1) throw UsageError("key 'rig.directions': each must be 1 or -1");
   if (hardware.type == "hardware") {
     if (hardware.port.empty() && !hardware.emulate_stages)
       throw UsageError("key 'rig.port': a hardware rig needs the stages' serial port (or rig.emulate_stages: true)");
@@ -231,6 +241,21 @@ void RunConfig::Check() const {
   if (fovea.fixation.baseline_m > widest)
     throw UsageError("key 'foveal.baseline_m': " + FormatNumber(fovea.fixation.baseline_m) +
                      " is wider than the carriages allow (2 x rig.carriage_max_m = " + FormatNumber(widest) + ")");
+}
+
+std::array<int, 6> SixInts(const std::string& text, const std::string& key) {
+  std::array<int, 6> v{};
+  std::stringstream ss(text);
+  std::string item;
+  int n = 0;
+  while (std::getline(ss, item, ',')) {
+    double x;
+    if (n == 6 || !ParseDouble(item, &x) || x != std::floor(x))
+      throw UsageError("key '" + key + "': expected six whole numbers separated by commas, got '" + text + "'");
+    v[n++] = static_cast<int>(x);
+  }
+  if (n != 6) throw UsageError("key '" + key + "': expected six whole numbers separated by commas, got '" + text + "'");
+  return v;
 }
 
 std::string CanonicalConfig(const RunConfig& const_config) {

@@ -3,6 +3,7 @@
 // work starts, and written back out in full beside the results.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <variant>
@@ -32,6 +33,8 @@ struct RunConfig {
     std::string port;
     int baud = 9600;
     bool emulate_stages = false;
+    std::string units = "1,2,3,4,5,6";    ///< indexer addresses in rig::Axis order
+    std::string directions = "1,1,1,1,1,1";  ///< motor direction signs in rig::Axis order
     std::string left_camera, right_camera, calibration;
     double frame_timeout_s = 2;
     double baseline_velocity_m_s = 0.05;
@@ -45,7 +48,8 @@ struct RunConfig {
   void Check() const;
 };
 
-
+/// Six whole numbers from "a,b,c,d,e,f"; throws UsageError naming `key`.
+std::array<int, 6> SixInts(const std::string& text, const std::string& key);
 
 /// One parameter: a path in the YAML file ("idr.unique_share"), what it is,
 /// and where it lives in a RunConfig.
