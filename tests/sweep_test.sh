@@ -11,10 +11,25 @@ rm -rf "$work"
 mkdir -p "$work"
 fail() { echo "FAIL: $*" >&2; exit 1; }
 
-# The CSV without its wall-clock columns (wall_time_s, compute_time_s, time_s.*).
+# The CSV without its wall-clock columns (wall_time_s, compute_time_s,
+# time_s.*). Fields are split at commas outside double quotes (values such
+# as rig.units "1,2,3,4,5,6" are quoted); plain awk, no gawk needed.
 strip() {
-  awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) keep[i] = !($i == "wall_time_s" || $i == "compute_time_s" || $i ~ /^time_s\./) }
-           { out = ""; sep = ""; for (i = 1; i <= NF; i++) if (keep[i]) { out = out sep $i; sep = "," } print out }' "$1"
+  awk 'function split_csv(line, f,    n, i, c, start, inq) {
+         n = 0; start = 1; inq = 0
+         for (i = 1; i <= length(line); i++) {
+           c = substr(line, i, 1)
+           if (c == "\"") inq = !inq
+           else if (c == "," && !inq) { f[++n] = substr(line, start, i - start); start = i + 1 }
+         }
+         f[++n] = substr(line, start)
+         return n
+       }
+       { n = split_csv($0, f)
+         if (NR == 1) { columns = n; for (i = 1; i <= n; i++) keep[i] = !(f[i] == "wall_time_s" || f[i] == "compute_time_s" || f[i] ~ /^time_s\./) }
+         if (n != columns) { print "row " NR " has " n " fields, the header " columns > "/dev/stderr"; exit 1 }
+         out = ""; sep = ""; for (i = 1; i <= n; i++) if (keep[i]) { out = out sep f[i]; sep = "," }
+         print out }' "$1"
 }
 done_runs() { ls "$1"/runs/*/summary.json 2>/dev/null | wc -l; }
 
