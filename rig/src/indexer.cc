@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <poll.h>
+#include <pty.h>
 #include <signal.h>
 #include <unistd.h>
 
@@ -101,13 +102,27 @@ class LibSerialLine : public SerialLine {
   int NativeHandle() const override { return port_.GetFileDescriptor(); }
   ~LibSerialLine() override {
     // LibSerial's Close restores the port's settings and throws when the
-    // line is gone (EIO), leaving the port open, and its destructor then
-    // throws again: close the descriptor ourselves and let the object go.
+    // line is gone (EIO), leaving the port open, and its destructor would
+    // then throw again.
     try {
       if (port_.IsOpen()) port_.Close();
     } catch (...) {
-      ::close(port_.GetFileDescriptor());
-      owned_.release();  // NOLINT(bugprone-unused-return-value): deliberately not destroyed
+      // The line is gone: put a fresh pseudo-terminal under the descriptor
+      // so that Close can restore settings and close it, then drop that.
+      int master = -1, slave = -1;
+      if (openpty(&master, &slave, nullptr, nullptr, nullptr) == 0) {
+        ::dup2(slave, port_.GetFileDescriptor());
+        ::close(slave);
+        try {
+          port_.Close();
+        } catch (...) {
+        }
+        ::close(master);
+      }
+      if (port_.IsOpen()) {
+        ::close(port_.GetFileDescriptor());
+        owned_.release();  // NOLINT(bugprone-unused-return-value): its destructor would throw
+      }
     }
   }
 
