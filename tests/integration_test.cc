@@ -2,20 +2,11 @@
 #include <catch2/catch.hpp>
 
 #include "fovea/integration.h"
+#include "test_views.h"
 
 namespace {
 
-rig::CameraView View() {
-  rig::CameraView v;
-  v.intrinsics.width_px = 320;
-  v.intrinsics.height_px = 240;
-  v.intrinsics.fx_px = v.intrinsics.fy_px = 300;
-  v.intrinsics.cx_px = 159.5;
-  v.intrinsics.cy_px = 119.5;
-  v.world_T_camera = Eigen::Isometry3d::Identity();
-  v.world_T_camera.linear() << 1, 0, 0, 0, 0, 1, 0, -1, 0;  // looks along +Y
-  return v;
-}
+rig::CameraView View() { return ForwardView(320, 240, 300); }
 
 // A grid of n x n square patches tiling [-h, h]^2 (X, Z) at depth y.
 fovea::PatchMap Grid(int n, double h, double y, fovea::PatchLevel level, int resolution = 0) {

@@ -4,20 +4,11 @@
 #include <opencv2/imgproc.hpp>
 
 #include "fovea/selection.h"
+#include "test_views.h"
 
 namespace {
 
-rig::CameraView View() {
-  rig::CameraView v;
-  v.intrinsics.width_px = 160;
-  v.intrinsics.height_px = 120;
-  v.intrinsics.fx_px = v.intrinsics.fy_px = 150;
-  v.intrinsics.cx_px = 79.5;
-  v.intrinsics.cy_px = 59.5;
-  v.world_T_camera = Eigen::Isometry3d::Identity();
-  v.world_T_camera.linear() << 1, 0, 0, 0, 0, 1, 0, -1, 0;
-  return v;
-}
+rig::CameraView View() { return ForwardView(160, 120, 150); }
 
 fovea::Patch Square(double x0, double x1, double z0, double z1, double y, fovea::PatchLevel level) {
   fovea::Patch p;

@@ -101,13 +101,6 @@ void RemoveStaging(const std::string& runs_dir, const std::string& id) {
     if (e.path().filename().string().rfind("." + id + ".partial-", 0) == 0) fs::remove_all(e.path(), ec);
 }
 
-std::string ReadText(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 struct SweepArgs {
   std::string file, out, shard;
   int jobs = -1;
@@ -134,14 +127,14 @@ int RunSweep(const SweepArgs& args) {
   const std::string dir = args.out.empty() ? "out/sweeps/" + fs::path(args.file).stem().string() : args.out;
   const nlohmann::json grid = GridJson(sweep);
   const std::string grid_text = grid.dump(1) + "\n";
-  if (fs::exists(dir + "/grid.json") && ReadText(dir + "/grid.json") != grid_text)
+  if (fs::exists(dir + "/grid.json") && ReadFile(dir + "/grid.json") != grid_text)
     throw UsageError("'" + dir + "' holds a different sweep (its grid.json differs); choose another --out");
   const std::string exe = SelfExe();
   EnsureDirectory(dir + "/runs");
   EnsureDirectory(dir + "/configs");
   EnsureDirectory(dir + "/logs");
   WriteTextAtomic(dir + "/grid.json", grid_text);
-  WriteTextAtomic(dir + "/sweep.yaml", ReadText(args.file));
+  WriteTextAtomic(dir + "/sweep.yaml", ReadFile(args.file));
 
   std::vector<const SweepRun*> mine, pending;
   for (size_t i = 0; i < sweep.runs.size(); ++i)
@@ -216,16 +209,16 @@ int Collect(const std::string& dir, const std::vector<std::string>& shards, bool
   if (!fs::exists(dir + "/grid.json")) {
     if (shards.empty()) throw UsageError("'" + dir + "' is not a sweep folder (no grid.json)");
     EnsureDirectory(dir + "/runs");
-    WriteTextAtomic(dir + "/grid.json", ReadText(shards[0] + "/grid.json"));
-    if (fs::exists(shards[0] + "/sweep.yaml")) WriteTextAtomic(dir + "/sweep.yaml", ReadText(shards[0] + "/sweep.yaml"));
+    WriteTextAtomic(dir + "/grid.json", ReadFile(shards[0] + "/grid.json"));
+    if (fs::exists(shards[0] + "/sweep.yaml")) WriteTextAtomic(dir + "/sweep.yaml", ReadFile(shards[0] + "/sweep.yaml"));
   }
-  const std::string grid_text = ReadText(dir + "/grid.json");
+  const std::string grid_text = ReadFile(dir + "/grid.json");
   const nlohmann::json grid = ReadJson(dir + "/grid.json");
   EnsureDirectory(dir + "/runs");
   int copied = 0;
   for (const std::string& s : shards) {
     if (fs::equivalent(s, dir)) continue;
-    if (ReadText(s + "/grid.json") != grid_text)
+    if (ReadFile(s + "/grid.json") != grid_text)
       throw UsageError("'" + s + "' holds a different sweep than '" + dir + "' (grid.json differs)");
     for (const auto& run : grid.at("runs")) {
       const std::string id = run.at("id").get<std::string>();

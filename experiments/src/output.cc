@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <system_error>
@@ -79,6 +80,13 @@ cv::Mat ColorizeDepth(const cv::Mat& depth_m, double min_m, double max_m) {
   cv::applyColorMap(scaled, color, cv::COLORMAP_TURBO);
   color.setTo(cv::Scalar(0, 0, 0), ~known);
   return color;
+}
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
 }
 
 }  // namespace experiments

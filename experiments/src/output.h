@@ -23,6 +23,9 @@ void WriteImageAtomic(const std::string& path, const cv::Mat& image);
 /// Same for text.
 void WriteTextAtomic(const std::string& path, const std::string& text);
 
+/// A whole file's bytes; "" when it cannot be read.
+std::string ReadFile(const std::string& path);
+
 /// Depth in metres (CV_32FC1, 0 = unknown) colour-mapped (turbo, near = red)
 /// over [min_m, max_m]; unknown pixels black. min_m = max_m = 0 picks the
 /// range of the known pixels.

@@ -19,13 +19,6 @@ namespace experiments {
 namespace fs = std::filesystem;
 namespace {
 
-std::string ReadBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 std::string Base64(const std::string& bytes) {
   static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
   std::string out;
@@ -63,7 +56,7 @@ std::string Quoted(const std::string& s) {
 }
 
 std::string Img(const std::string& path, const std::string& alt) {
-  return "<figure><img src=\"data:image/png;base64," + Base64(ReadBytes(path)) + "\" alt=\"" + Html(alt) +
+  return "<figure><img src=\"data:image/png;base64," + Base64(ReadFile(path)) + "\" alt=\"" + Html(alt) +
          "\"><figcaption>" + Html(alt) + "</figcaption></figure>\n";
 }
 
@@ -319,8 +312,8 @@ std::string GnuplotSvg(const std::string& title, const std::string& xlabel, cons
   }
   const std::string cmd = "gnuplot " + base + ".gp 2>" + base + ".err";
   const int status = std::system(cmd.c_str());
-  const std::string svg = ReadBytes(base + ".svg");
-  const std::string err = ReadBytes(base + ".err");
+  const std::string svg = ReadFile(base + ".svg");
+  const std::string err = ReadFile(base + ".err");
   std::error_code ec;
   for (const char* ext : {".gp", ".svg", ".err"}) fs::remove(base + ext, ec);
   if (status != 0 || svg.empty())
