@@ -99,3 +99,46 @@ TEST_CASE("selection: deterministic takes the maximum; draws are reproducible fr
   REQUIRE(refused.ok);
   CHECK((refused.point_W - s.point_W).norm() >= o.refused_radius_m);
 }
+
+TEST_CASE("graded suppression: peripheral data weighs between foveal data and the rest", "[fovea][selection]") {
+  fovea::PatchMap map;
+  map.Add(Square(-1, -0.3, -1, 1, 1.0, fovea::PatchLevel::kFoveal));
+  map.Add(Square(-0.3, 0.3, -1, 1, 1.0, fovea::PatchLevel::kPeripheral));
+  map.Add(Square(0.3, 1, -1, 1, 1.0, fovea::PatchLevel::kIdr));
+  const fovea::SelectionContext c = fovea::SelectionContext::Make(HalfTextured(), View(), map);
+  // Columns: foveal at x = 10, peripheral at x = 80, IDR at x = 150 (f = 150, 1 m away).
+  const cv::Mat graded = fovea::LocalSuppression(0.02, 0.0, 0.3).Evaluate(c);
+  CHECK(graded.at<double>(60, 80) == Approx(0.3 * graded.at<double>(60, 150)));
+  CHECK(graded.at<double>(60, 10) == Approx(0.02 * graded.at<double>(60, 150)));
+  // The paper's rule: peripheral data is not suppressed.
+  const cv::Mat paper = fovea::LocalSuppression(0.02, 0.0, 1.0).Evaluate(c);
+  CHECK(paper.at<double>(60, 80) == Approx(paper.at<double>(60, 150)));
+}
+
+TEST_CASE("holes in the map take the nearest mapped depth and can be fixated", "[fovea][selection]") {
+  fovea::PatchMap map;
+  map.Add(Square(-1, 0, -1, 1, 2.0, fovea::PatchLevel::kPeripheral));  // left half only, 2 m
+  const cv::Mat image = HalfTextured();                                 // texture on the right: the hole
+  const fovea::SelectionContext plain = fovea::SelectionContext::Make(image, View(), map);
+  const fovea::SelectionContext filled = fovea::SelectionContext::Make(image, View(), map, true);
+  CHECK(plain.map_depth_m.at<float>(60, 120) == 0.f);
+  CHECK(filled.map_depth_m.at<float>(60, 120) == Approx(2.0));
+  CHECK(filled.map_level.at<signed char>(60, 120) == -1);  // still known as a hole
+  CHECK(filled.map_depth_m.at<float>(60, 30) == plain.map_depth_m.at<float>(60, 30));
+
+  fovea::SelectionOptions o;
+  o.deterministic = true;
+  const fovea::FixationSelector selector(fovea::FixationSelector::DefaultCriteria(), o);
+  std::mt19937_64 rng(1);
+  // Without filling, only the untextured mapped half can be chosen.
+  const auto s_plain = selector.Choose(plain, map, {}, &rng);
+  REQUIRE(s_plain.ok);
+  CHECK(s_plain.pixel.x() < 80);
+  CHECK_FALSE(s_plain.in_hole);
+  // With it, the textured hole wins, at the guessed depth.
+  const auto s_filled = selector.Choose(filled, map, {}, &rng);
+  REQUIRE(s_filled.ok);
+  CHECK(s_filled.pixel.x() >= 80);
+  CHECK(s_filled.in_hole);
+  CHECK(s_filled.point_W.y() == Approx(2.0).margin(1e-6));
+}

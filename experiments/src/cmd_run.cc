@@ -50,7 +50,8 @@ nlohmann::json RecordJson(const fovea::FixationRecord& r, const MapScore& score)
                     {"composite_max", s.composite_max},
                     {"composite_chosen", s.composite_chosen},
                     {"drawn_value", s.drawn_value},
-                    {"bin", s.bin}};
+                    {"bin", s.bin},
+                    {"in_hole", s.in_hole}};
   for (const auto& [name, v] : s.criteria) j["selection"]["criteria_vs_mean"][name] = v;
   j["target_W"] = Vec(r.target_W);
   j["motion_time_s"] = r.motion_time_s;

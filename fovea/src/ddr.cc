@@ -29,6 +29,7 @@ void CriteriaOptions::Check() const {
   if (!(gradient_blur_px > 0)) bad("criteria.gradient_blur_px must be > 0");
   if (!(suppressed_weight >= 0 && suppressed_weight <= 1)) bad("criteria.suppressed_weight must be in [0, 1]");
   if (!(suppression_radius_m >= 0)) bad("criteria.suppression_radius_m must be >= 0");
+  if (!(peripheral_weight >= 0 && peripheral_weight <= 1)) bad("criteria.peripheral_weight must be in [0, 1]");
   if (!(proximity_2d_scale_px > 0)) bad("criteria.proximity_2d_scale_px must be > 0");
   if (!(proximity_3d_low >= 0 && proximity_3d_low <= 1)) bad("criteria.proximity_3d_low must be in [0, 1]");
 }
@@ -36,7 +37,7 @@ void CriteriaOptions::Check() const {
 std::vector<std::shared_ptr<const FixationCriterion>> CriteriaOptions::Make() const {
   std::vector<std::shared_ptr<const FixationCriterion>> c;
   if (gradient) c.push_back(std::make_shared<GradientAttraction>(gradient_blur_px));
-  if (suppression) c.push_back(std::make_shared<LocalSuppression>(suppressed_weight, suppression_radius_m));
+  if (suppression) c.push_back(std::make_shared<LocalSuppression>(suppressed_weight, suppression_radius_m, peripheral_weight));
   if (proximity_2d) c.push_back(std::make_shared<Proximity2D>(proximity_2d_scale_px));
   if (proximity_3d) c.push_back(std::make_shared<Proximity3D>(proximity_3d_low));
   return c;
@@ -92,7 +93,7 @@ FoveaRun RunFovea(rig::Rig& rig, const StereoMatcher& matcher, const FoveaOption
       rec.selection.ok = true;
       rec.selection.point_W = run.idr.first_fixation_W;
     } else {
-      SelectionContext context = SelectionContext::Make(view.gray, view, run.map);
+      SelectionContext context = SelectionContext::Make(view.gray, view, run.map, options.fixate_holes);
       context.has_fixation = has_fixation;
       context.fixation_depth_m = current.fixation_depth_m;
       context.z_t_near_m = current.z_t_near_m;

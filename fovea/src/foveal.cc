@@ -135,12 +135,13 @@ FovealResult FovealStereo(const rig::StereoFrame& frame, const Eigen::Vector3d& 
             const float d = dm.disparity_px.at<float>(y, x);
             if (std::isfinite(d)) samples.push_back({double(x), double(y), d});
           }
-        Eigen::Vector4d box;
-        const auto fit = FitDisparityPlane(samples, bx, by, size, fit_options, &box);
+        const auto fit = FitDisparityPlane(samples, bx, by, size, fit_options);
         if (!fit) continue;
-        const double ex0 = std::max(bx - 0.5, box(0) - 0.5), ey0 = std::max(by - 0.5, box(1) - 0.5);
-        const double ex1 = std::min(bx + size - 0.5, box(2) + 0.5), ey1 = std::min(by + size - 0.5, box(3) + 0.5);
-        if (ex1 - ex0 < 1 || ey1 - ey0 < 1) continue;
+        // The patch spans its whole block: the fit has inliers in all four
+        // quadrants, and blocks that tile the image leave no cracks between
+        // their patches (shrinking to the inliers' extent left gaps of up to
+        // a level pixel, 8 full-resolution pixels at level 3).
+        const double ex0 = bx - 0.5, ey0 = by - 0.5, ex1 = bx + size - 0.5, ey1 = by + size - 0.5;
         Patch p;
         p.level = level == 0 ? PatchLevel::kFoveal : PatchLevel::kPeripheral;
         p.resolution_level = level;

@@ -10,7 +10,8 @@
 
 namespace fovea {
 
-SelectionContext SelectionContext::Make(const cv::Mat& image, const rig::CameraView& view, const PatchMap& map) {
+SelectionContext SelectionContext::Make(const cv::Mat& image, const rig::CameraView& view, const PatchMap& map,
+                                        bool fill_holes) {
   SelectionContext c;
   c.image = image;
   c.view = view;
@@ -22,6 +23,19 @@ SelectionContext SelectionContext::Make(const cv::Mat& image, const rig::CameraV
       const int id = ids.at<int>(y, x);
       if (id >= 0) c.map_level.at<signed char>(y, x) = static_cast<signed char>(map[id].level);
     }
+  if (!fill_holes) return c;
+  const cv::Mat holes = c.map_depth_m <= 0;
+  if (cv::countNonZero(holes) == 0 || cv::countNonZero(holes) == static_cast<int>(holes.total())) return c;
+  // Each hole pixel gets the label of its nearest mapped (zero) pixel.
+  cv::Mat distance, labels;
+  cv::distanceTransform(holes, distance, labels, cv::DIST_L2, cv::DIST_MASK_5, cv::DIST_LABEL_PIXEL);
+  std::vector<float> depth_of_label(holes.total() + 1, 0.f);
+  for (int y = 0; y < holes.rows; ++y)
+    for (int x = 0; x < holes.cols; ++x)
+      if (!holes.at<uchar>(y, x)) depth_of_label[labels.at<int>(y, x)] = c.map_depth_m.at<float>(y, x);
+  for (int y = 0; y < holes.rows; ++y)
+    for (int x = 0; x < holes.cols; ++x)
+      if (holes.at<uchar>(y, x)) c.map_depth_m.at<float>(y, x) = depth_of_label[labels.at<int>(y, x)];
   return c;
 }
 
@@ -58,10 +72,12 @@ cv::Mat LocalSuppression::Evaluate(const SelectionContext& c) const {
   cv::Mat w(c.map_level.size(), CV_64F, cv::Scalar(1.0));
   for (int y = 0; y < w.rows; ++y)
     for (int x = 0; x < w.cols; ++x) {
-      if (c.map_level.at<signed char>(y, x) == static_cast<signed char>(PatchLevel::kFoveal)) {
+      const signed char level = c.map_level.at<signed char>(y, x);
+      if (level == static_cast<signed char>(PatchLevel::kFoveal)) {
         w.at<double>(y, x) = low_;
         continue;
       }
+      if (level == static_cast<signed char>(PatchLevel::kPeripheral)) w.at<double>(y, x) = peripheral_;
       if (c.fixated_W.empty() || c.map_depth_m.at<float>(y, x) <= 0) continue;
       const Eigen::Vector3d p = c.MapPoint(x, y);
       for (const Eigen::Vector3d& f : c.fixated_W)
@@ -217,11 +233,16 @@ SelectionSummary FixationSelector::Choose(const SelectionContext& c, const Patch
   s.composite_chosen = composite.at<double>(by, bx);
   const Ray ray = PixelRay(c.view.world_T_camera, c.view.intrinsics, s.pixel);
   const auto hit = map.CastRay(ray.origin_W, ray.direction_W);
-  if (!hit) {
+  if (hit) {
+    s.point_W = ray.origin_W + hit->distance_m * ray.direction_W;
+  } else if (c.map_level.at<signed char>(by, bx) < 0) {
+    // A hole the context filled (see SelectionContext::Make): its guessed depth.
+    s.point_W = c.MapPoint(bx, by);
+    s.in_hole = true;
+  } else {
     s.why = "the chosen pixel's ray misses the map";
     return s;
   }
-  s.point_W = ray.origin_W + hit->distance_m * ray.direction_W;
   const cv::Mat candidates = composite > 0;
   for (size_t i = 0; i < criteria_.size(); ++i) {
     const double mean = cv::mean(each[i], candidates)[0];

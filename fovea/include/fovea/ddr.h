@@ -28,8 +28,9 @@ struct CriteriaOptions {
   bool proximity_3d = true;
   double gradient_blur_px = 2.0;
   double suppressed_weight = 0.02;  ///< local suppression's weight on foveal data
-  double suppression_radius_m = 0.04;  ///< and within this distance of an earlier fixation
-  double proximity_2d_scale_px = 160;
+  double suppression_radius_m = 0.08;  ///< and within this distance of an earlier fixation
+  double peripheral_weight = 0.3;   ///< local suppression's weight on peripheral data (paper: 1)
+  double proximity_2d_scale_px = 320;
   double proximity_3d_low = 0.1;    ///< 3D proximity's weight outside the Z_T band
   void Check() const;
   std::vector<std::shared_ptr<const FixationCriterion>> Make() const;
@@ -44,6 +45,9 @@ struct FoveaOptions {
   int fixations = 25;          ///< successful fixations to make
   /// Fixate only points inside the IDR view: the region the run maps.
   bool stay_in_idr_view = true;
+  /// Beyond the paper: pixels the map is silent at are fixation candidates
+  /// too, at the depth of the nearest mapped pixel (SelectionContext::Make).
+  bool fixate_holes = true;
   /// Stop early when the map's foveal share of the IDR view grew by less
   /// than `stall_growth` over this many fixations in a row (0 = never).
   int stall_fixations = 0;

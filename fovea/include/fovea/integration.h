@@ -13,7 +13,7 @@ struct IntegrationOptions {
   /// view shows finer map data (peripheral never replaces foveal); an old
   /// patch is removed when at least this share of its visible footprint is
   /// covered by kept new patches of its level or finer.
-  double overlap_share = 0.5;
+  double overlap_share = 0.9;
   void Check() const;  ///< throws std::invalid_argument naming the field
 };
 

@@ -22,7 +22,10 @@ namespace fovea {
 struct SelectionContext {
   cv::Mat image;                ///< current left view, CV_8UC1
   rig::CameraView view;         ///< its camera
-  cv::Mat map_depth_m;          ///< the map rendered into the view (CV_32F, 0 = none)
+  /// The map rendered into the view (CV_32F, 0 = none). With hole filling,
+  /// pixels the map is silent at carry the depth of the nearest mapped pixel
+  /// (map_level stays -1 there).
+  cv::Mat map_depth_m;
   cv::Mat map_level;            ///< CV_8S: PatchLevel of the patch seen, -1 = none
   bool has_fixation = false;    ///< false before the first vergent fixation
   double fixation_depth_m = 0;  ///< depth of the current fixation point in the view
@@ -35,8 +38,12 @@ struct SelectionContext {
   /// The map point seen at a pixel (requires map_depth_m > 0 there).
   Eigen::Vector3d MapPoint(int x, int y) const;
 
-  /// Renders `map` into `view` and fills map_depth_m and map_level.
-  static SelectionContext Make(const cv::Mat& image, const rig::CameraView& view, const PatchMap& map);
+  /// Renders `map` into `view` and fills map_depth_m and map_level. With
+  /// `fill_holes`, pixels the map is silent at take the depth of the nearest
+  /// pixel it shows (Euclidean distance in the image), so that the unmapped
+  /// parts of the view can be fixated: the servo then finds their depth.
+  static SelectionContext Make(const cv::Mat& image, const rig::CameraView& view, const PatchMap& map,
+                               bool fill_holes = false);
 };
 
 /// One criterion: a non-negative weight per pixel (CV_64F, the view's size)
@@ -63,16 +70,20 @@ class GradientAttraction : public FixationCriterion {
 /// Low weight where the map already holds foveal data or lies within
 /// `radius_m` of an earlier fixation point (a fixation whose fovea yielded
 /// no patches, at a depth edge say, must not attract the eye forever), high
-/// elsewhere.
+/// elsewhere. Beyond the paper, `peripheral_weight` grades the suppression:
+/// the weight where the map holds peripheral data (1 = the paper's rule, which
+/// suppresses foveal data only), so that the eye prefers what is mapped
+/// coarsely or not at all.
 class LocalSuppression : public FixationCriterion {
  public:
-  explicit LocalSuppression(double suppressed_weight = 0.02, double radius_m = 0.04)
-      : low_(suppressed_weight), radius_(radius_m) {}
+  explicit LocalSuppression(double suppressed_weight = 0.02, double radius_m = 0.04,
+                            double peripheral_weight = 1.0)
+      : low_(suppressed_weight), radius_(radius_m), peripheral_(peripheral_weight) {}
   std::string Name() const override { return "suppression"; }
   cv::Mat Evaluate(const SelectionContext& context) const override;
 
  private:
-  double low_, radius_;
+  double low_, radius_, peripheral_;
 };
 
 /// exp(-r / s), r the distance from the image centre in pixels.
@@ -118,6 +129,7 @@ struct SelectionSummary {
   std::string why;                  ///< when not ok
   Eigen::Vector2d pixel = Eigen::Vector2d::Zero();
   Eigen::Vector3d point_W = Eigen::Vector3d::Zero();
+  bool in_hole = false;             ///< the pixel showed no map data: point_W is a guess
   int candidates = 0;               ///< pixels with a map point
   double composite_max = 0, composite_chosen = 0;
   double drawn_value = 0;           ///< c drawn from the exponential density
