@@ -12,6 +12,7 @@
 #include "config.h"
 #include "fovea/ddr.h"
 #include "fovea/sgbm.h"
+#include "fovea/timing.h"
 #include "output.h"
 #include "run_eval.h"
 #include "run_output.h"
@@ -23,8 +24,8 @@ namespace experiments {
 namespace fs = std::filesystem;
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double Since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+using fovea::Clock;
+using fovea::Since;
 
 struct RunArgs {
   std::string config_path;

@@ -3,16 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "stats.h"
+
 namespace experiments {
-namespace {
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return std::nan("");
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
-
-}  // namespace
 
 FovealScore ScoreFoveal(const fovea::FixationResult& r, const sim::GroundTruth& truth) {
   FovealScore score;
@@ -71,11 +64,11 @@ FovealScore ScoreFoveal(const fovea::FixationResult& r, const sim::GroundTruth& 
         const double ur = frame.right.intrinsics.fx_px * p_R.x() / p_R.z() + frame.right.intrinsics.cx_px;
         derr.push_back(std::abs(dd - (u - ur) / s));
       }
-    score.levels[level].median_disparity_error_px = Median(derr);
+    score.levels[level].median_disparity_error_px = Quantile(derr, 0.5, std::nan(""));
   }
   for (int level = 0; level < levels; ++level) {
-    score.levels[level].median_abs_error_m = Median(err[level]);
-    score.levels[level].median_error_steps = Median(steps[level]);
+    score.levels[level].median_abs_error_m = Quantile(err[level], 0.5, std::nan(""));
+    score.levels[level].median_error_steps = Quantile(steps[level], 0.5, std::nan(""));
   }
   score.fovea_coverage = fovea_pixels ? double(fovea_matched) / fovea_pixels : 0.0;
   return score;

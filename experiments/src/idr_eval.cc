@@ -3,14 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
+#include "stats.h"
+
 namespace experiments {
 namespace {
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
 
 // Planar depth where the pixel's ray meets the patch's plane.
 double PlaneDepth(const fovea::Patch& p, const rig::CameraView& view, const Eigen::Vector2d& uv) {
@@ -76,8 +72,8 @@ IdrScore ScoreIdr(const fovea::IdrResult& r, const sim::GroundTruth& truth) {
       }
     if (straddles) ++s.straddling_patches;
   }
-  s.median_abs_error_m = Median(errors);
-  s.median_error_steps = Median(steps);
+  s.median_abs_error_m = Quantile(errors, 0.5);
+  s.median_error_steps = Quantile(steps, 0.5);
   for (const fovea::DisparitySample& m : r.final_samples) {
     ++s.matches;
     const double zt = TrueDepth(truth, view, {m.x_px, m.y_px});

@@ -4,15 +4,10 @@
 #include <cmath>
 #include <map>
 
+#include "stats.h"
+
 namespace experiments {
 namespace {
-
-double Quantile(std::vector<double> v, double q) {
-  if (v.empty()) return 0;
-  const size_t k = std::min(v.size() - 1, static_cast<size_t>(q * v.size()));
-  std::nth_element(v.begin(), v.begin() + k, v.end());
-  return v[k];
-}
 
 struct Accumulator {
   std::vector<double> abs, rel, steps;

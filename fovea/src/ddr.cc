@@ -1,13 +1,11 @@
 #include "fovea/ddr.h"
 
-#include <chrono>
 #include <stdexcept>
+
+#include "fovea/timing.h"
 
 namespace fovea {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double Since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 // Share of the view's pixels where the map shows foveal data.
 double FovealShare(const PatchMap& map, const rig::CameraView& view) {

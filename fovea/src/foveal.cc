@@ -1,18 +1,15 @@
 #include "fovea/foveal.h"
 
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
 #include "fovea/geometry.h"
+#include "fovea/timing.h"
 
 namespace fovea {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double Since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 // Full-resolution horizontal disparity of the point at planar depth z on the
 // left ray through (u, v).

@@ -1,16 +1,14 @@
 #include "fovea/idr.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <stdexcept>
 #include <unordered_map>
 
+#include "fovea/timing.h"
+
 namespace fovea {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double Since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 double AngleDiff(double a, double b) {
   double d = std::fmod(std::abs(a - b), 2 * M_PI);

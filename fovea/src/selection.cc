@@ -25,7 +25,8 @@ SelectionContext SelectionContext::Make(const cv::Mat& image, const rig::CameraV
     }
   if (!fill_holes) return c;
   const cv::Mat holes = c.map_depth_m <= 0;
-  if (cv::countNonZero(holes) == 0 || cv::countNonZero(holes) == static_cast<int>(holes.total())) return c;
+  const int n_holes = cv::countNonZero(holes);
+  if (n_holes == 0 || n_holes == static_cast<int>(holes.total())) return c;
   // Each hole pixel gets the label of its nearest mapped (zero) pixel.
   cv::Mat distance, labels;
   cv::distanceTransform(holes, distance, labels, cv::DIST_L2, cv::DIST_MASK_5, cv::DIST_LABEL_PIXEL);
