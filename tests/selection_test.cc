@@ -115,6 +115,26 @@ TEST_CASE("graded suppression: peripheral data weighs between foveal data and th
   CHECK(paper.at<double>(60, 80) == Approx(paper.at<double>(60, 150)));
 }
 
+TEST_CASE("local suppression: zero weight at earlier fixations, low weight around them", "[fovea][selection]") {
+  fovea::PatchMap map;
+  map.Add(Square(-1, 0, -1, 1, 1.0, fovea::PatchLevel::kFoveal));  // left half foveal, 1 m
+  map.Add(Square(0, 1, -1, 1, 1.0, fovea::PatchLevel::kIdr));      // right half IDR, 1 m
+  fovea::SelectionContext c = fovea::SelectionContext::Make(HalfTextured(), View(), map);
+  // f = 150 px, 1 m away: pixel column x lies at (x - 80) / 150 m.
+  c.fixated_W = {Eigen::Vector3d(40.0 / 150, 1.0, 0.0), Eigen::Vector3d(-40.0 / 150, 1.0, 0.0)};
+  const cv::Mat w = fovea::LocalSuppression(0.02, 0.08, 0.3, 0.03).Evaluate(c);
+  const double free = w.at<double>(60, 150);  // 0.2 m from the nearest fixation
+  REQUIRE(free > 0);
+  CHECK(w.at<double>(60, 120) == 0.0);                        // on the IDR fixation point
+  CHECK(w.at<double>(60, 123) == 0.0);                        // 2 cm away
+  CHECK(w.at<double>(60, 126) == Approx(0.02 * free));        // 4 cm away: within the radius
+  CHECK(w.at<double>(60, 40) == 0.0);                         // foveal data is 0 at a fixation too
+  CHECK(w.at<double>(60, 10) == Approx(0.02 * free));         // and 0.02 elsewhere
+  // Without a revisit radius the fixation point itself keeps the low weight.
+  const cv::Mat paper = fovea::LocalSuppression(0.02, 0.08, 0.3, 0.0).Evaluate(c);
+  CHECK(paper.at<double>(60, 120) == Approx(0.02 * paper.at<double>(60, 150)));
+}
+
 TEST_CASE("holes in the map take the nearest mapped depth and can be fixated", "[fovea][selection]") {
   fovea::PatchMap map;
   map.Add(Square(-1, 0, -1, 1, 2.0, fovea::PatchLevel::kPeripheral));  // left half only, 2 m

@@ -2,6 +2,8 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
+#include "fovea/foveal.h"
+#include "fovea/geometry.h"
 #include "fovea/servo.h"
 #include "fovea/vergence.h"
 #include "scenes/catalog.h"
@@ -37,4 +39,60 @@ TEST_CASE("servoing converges from 20 px off within 6 steps", "[fovea][servo][sl
     CHECK(std::abs(r.residual_px) < 0.5);
     CHECK(r.iterations <= 6);
   }
+}
+
+namespace {
+
+// A point on the left camera's axis as it fixates p_W, `scale` times as far
+// from the camera: fixating it points the left camera at p_W again, with the
+// depth guessed wrong.
+Eigen::Vector3d OnLeftAxis(rig::Rig& rig, const Eigen::Vector3d& p_W, double scale) {
+  const auto sol = fovea::Verge(rig.Geometry(), rig.Limits(), rig.Intrinsics(rig::Side::kLeft),
+                                rig.Intrinsics(rig::Side::kRight), rig::StageState::Parallel(0.12), p_W);
+  REQUIRE(sol.ok);
+  rig.MoveTo(sol.state);
+  const Eigen::Vector3d c = rig.Capture().left.world_T_camera.translation();
+  return c + scale * (p_W - c);
+}
+
+}  // namespace
+
+TEST_CASE("a guessed depth: the servo searches every depth and finds the surface", "[fovea][servo][slow]") {
+  sim::SimRigConfig config;
+  config.noise.read_noise_sigma_dn = 2.0;
+  auto sim = scenes::LoadScene("three_surfaces", config);
+  rig::Rig& rig = sim->rig();
+  const fovea::Nl1Matcher matcher;
+  const fovea::PatchMap empty;
+  // The left wooden block's face at 0.50 m, guessed at 1.2 m (the plywood's
+  // depth, as a hole's nearest mapped neighbour would have it): about 170 px
+  // of disparity, far beyond the +-40 px of the ordinary search.
+  const Eigen::Vector3d block(-0.11, 0.50, -0.055);
+  const Eigen::Vector3d guess = OnLeftAxis(rig, block, 2.4);
+  const fovea::DepthRange every{0.4, fovea::kFarDepthM};
+  const fovea::FixationResult wide = fovea::Fixate(rig, empty, guess, matcher, {}, 0, every);
+  INFO("wide: " << wide.why << " fixated at " << wide.fixation_W.transpose());
+  REQUIRE(wide.ok);
+  CHECK(wide.servo.converged);
+  CHECK((wide.fixation_W - block).norm() < 0.02);
+  const fovea::FixationResult narrow = fovea::Fixate(rig, empty, guess, matcher, {});
+  INFO("narrow: fixated at " << narrow.fixation_W.transpose());
+  CHECK((narrow.fixation_W - block).norm() > 0.1);
+}
+
+TEST_CASE("a guessed depth on a periodic texture: no unique match, the point is refused", "[fovea][servo][slow]") {
+  sim::SimRigConfig config;
+  config.noise.read_noise_sigma_dn = 2.0;
+  auto sim = scenes::LoadScene("periodic", config);
+  rig::Rig& rig = sim->rig();
+  const fovea::Nl1Matcher matcher;
+  const fovea::PatchMap empty;
+  // The stripes (period about 21 px) at 0.9 m, guessed at 0.6 m: every
+  // period in the search matches as well as the true one.
+  const Eigen::Vector3d guess = OnLeftAxis(rig, {0.0, 0.9, 0.0}, 2.0 / 3.0);
+  const fovea::FixationResult r =
+      fovea::Fixate(rig, empty, guess, matcher, {}, 0, fovea::DepthRange{0.4, fovea::kFarDepthM});
+  CHECK_FALSE(r.ok);
+  CHECK(r.why.find("unique") != std::string::npos);
+  CHECK(r.foveal.patches.size() == 0);
 }

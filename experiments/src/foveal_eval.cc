@@ -39,6 +39,7 @@ FovealScore ScoreFoveal(const fovea::FixationResult& r, const sim::GroundTruth& 
     const Eigen::Vector3d n_C = camera_T_world.linear() * p.Normal();
     const double z = n_C.dot(c_C) / n_C.dot(ray);
     err[level].push_back(std::abs(z - zt));
+    if (std::abs(z - zt) > 0.05 * zt) ++score.levels[level].gross_errors;
     steps[level].push_back(std::abs(z - zt) / (std::pow(2.0, level) * zt * zt / (k.fx_px * b)));
   }
   // Per-pixel disparities against truth, and the fovea's coverage.
@@ -101,6 +102,7 @@ nlohmann::json FixationJson(const fovea::FixationResult& r, const FovealScore& s
       l["median_abs_error_m"] = s.levels[i].median_abs_error_m;
       l["median_error_steps"] = s.levels[i].median_error_steps;
       l["median_disparity_error_px"] = s.levels[i].median_disparity_error_px;
+      l["gross_errors"] = s.levels[i].gross_errors;
     }
     levels.push_back(l);
   }

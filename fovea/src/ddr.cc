@@ -2,10 +2,12 @@
 
 #include <stdexcept>
 
+#include "fovea/geometry.h"
 #include "fovea/timing.h"
 
 namespace fovea {
 namespace {
+
 
 // Share of the view's pixels where the map shows foveal data.
 double FovealShare(const PatchMap& map, const rig::CameraView& view) {
@@ -28,6 +30,7 @@ void CriteriaOptions::Check() const {
   if (!(suppressed_weight >= 0 && suppressed_weight <= 1)) bad("criteria.suppressed_weight must be in [0, 1]");
   if (!(suppression_radius_m >= 0)) bad("criteria.suppression_radius_m must be >= 0");
   if (!(peripheral_weight >= 0 && peripheral_weight <= 1)) bad("criteria.peripheral_weight must be in [0, 1]");
+  if (!(revisit_radius_m >= 0)) bad("criteria.revisit_radius_m must be >= 0");
   if (!(proximity_2d_scale_px > 0)) bad("criteria.proximity_2d_scale_px must be > 0");
   if (!(proximity_3d_low >= 0 && proximity_3d_low <= 1)) bad("criteria.proximity_3d_low must be in [0, 1]");
 }
@@ -35,7 +38,8 @@ void CriteriaOptions::Check() const {
 std::vector<std::shared_ptr<const FixationCriterion>> CriteriaOptions::Make() const {
   std::vector<std::shared_ptr<const FixationCriterion>> c;
   if (gradient) c.push_back(std::make_shared<GradientAttraction>(gradient_blur_px));
-  if (suppression) c.push_back(std::make_shared<LocalSuppression>(suppressed_weight, suppression_radius_m, peripheral_weight));
+  if (suppression) c.push_back(std::make_shared<LocalSuppression>(suppressed_weight, suppression_radius_m, peripheral_weight,
+                                                                    revisit_radius_m));
   if (proximity_2d) c.push_back(std::make_shared<Proximity2D>(proximity_2d_scale_px));
   if (proximity_3d) c.push_back(std::make_shared<Proximity3D>(proximity_3d_low));
   return c;
@@ -109,8 +113,12 @@ FoveaRun RunFovea(rig::Rig& rig, const StereoMatcher& matcher, const FoveaOption
       break;
     }
     rec.target_W = rec.selection.point_W;
+    // A hole's depth is the nearest mapped depth, a guess: the servo searches
+    // every depth from the nearest the scene allows to infinity.
+    const std::optional<DepthRange> guessed =
+        rec.selection.in_hole ? std::optional<DepthRange>(DepthRange{options.idr.z_min_m, kFarDepthM}) : std::nullopt;
     const FixationResult r =
-        Fixate(rig, run.map, rec.target_W, matcher, options.fixation, run.fixations_done + 1);
+        Fixate(rig, run.map, rec.target_W, matcher, options.fixation, run.fixations_done + 1, guessed);
     rec.time.verge_s = r.verge_time_s;
     rec.time.servo_s = r.servo_wall_s;
     rec.motion_time_s = r.motion_time_s;
@@ -146,6 +154,9 @@ FoveaRun RunFovea(rig::Rig& rig, const StereoMatcher& matcher, const FoveaOption
     rec.foveal_share = FovealShare(run.map, idr_view);
     has_fixation = true;
     fixated.push_back(rec.fixation_W);
+    // A hole's guessed point stays a hole where the fixation found another
+    // depth along its ray and mapped nothing there: suppress it as well.
+    if (rec.selection.in_hole) fixated.push_back(rec.target_W);
     current = rec.tessellation;
     run.compute_time_s += rec.time.ComputeS();
     run.records.push_back(rec);

@@ -11,6 +11,7 @@
 namespace fovea {
 namespace {
 
+
 // Full-resolution horizontal disparity of the point at planar depth z on the
 // left ray through (u, v).
 double DisparityAtDepth(const rig::CameraView& left, const rig::CameraView& right,
@@ -27,6 +28,7 @@ void FovealOptions::Check() const {
   tessellation.Check();
   if (fovea_patch_px < 3 || periphery_patch_px < 3) throw std::invalid_argument("foveal: patch sizes must be >= 3");
   if (!(map_margin_px > 0) || !(coarse_margin_px > 0)) throw std::invalid_argument("foveal: margins must be positive");
+  if (!(silent_near_m >= 0)) throw std::invalid_argument("foveal: silent_near_m must be >= 0");
 }
 
 void FixationOptions::Check() const {
@@ -68,6 +70,8 @@ FovealResult FovealStereo(const rig::StereoFrame& frame, const Eigen::Vector3d& 
     }
     const cv::Rect& rect = t.rects[level];
     cv::Mat lo(l.size(), CV_32F, cv::Scalar(1)), hi(l.size(), CV_32F, cv::Scalar(0));  // lo > hi: skip
+    // Where the map is silent: the range from silent_near_m to infinity.
+    cv::Mat wide_lo(l.size(), CV_32F, cv::Scalar(1)), wide_hi(l.size(), CV_32F, cv::Scalar(0));
     const cv::Mat* coarse = level + 1 < levels ? &result.disparity_px[level + 1] : nullptr;
     for (int y = 0; y < l.rows; ++y)
       for (int x = 0; x < l.cols; ++x) {
@@ -93,18 +97,44 @@ FovealResult FovealStereo(const rig::StereoFrame& frame, const Eigen::Vector3d& 
           const double b = DisparityAtDepth(left, right, right_T_left, u, v, z0 + t.z_t_far_m) / s;
           dlo = std::min(a, b) - 1;
           dhi = std::max(a, b) + 1;
+          if (options.silent_near_m > 0) {
+            const double n = DisparityAtDepth(left, right, right_T_left, u, v, options.silent_near_m) / s;
+            const double f = DisparityAtDepth(left, right, right_T_left, u, v, kFarDepthM) / s;
+            if (std::isfinite(n) && std::isfinite(f)) {
+              wide_lo.at<float>(y, x) = static_cast<float>(std::min({dlo, n, f}));
+              wide_hi.at<float>(y, x) = static_cast<float>(std::max({dhi, n, f}));
+            }
+          }
         }
         if (!std::isfinite(dlo) || !std::isfinite(dhi)) continue;
         lo.at<float>(y, x) = static_cast<float>(dlo);
         hi.at<float>(y, x) = static_cast<float>(dhi);
       }
-    const DisparityMap dm = matcher.Match(l, r, lo, hi);
+    DisparityMap dm = matcher.Match(l, r, lo, hi);
+    // A band match where the wide search confidently matched outside Z_T is
+    // a false match of a surface the band does not hold: dropped.
+    int outside_band = 0;
+    if (options.silent_near_m > 0) {
+      const DisparityMap wide = matcher.Match(l, r, wide_lo, wide_hi);
+      for (int y = 0; y < l.rows; ++y)
+        for (int x = 0; x < l.cols; ++x) {
+          float& d = dm.disparity_px.at<float>(y, x);
+          const float w = wide.disparity_px.at<float>(y, x);
+          if (!std::isfinite(d) || !std::isfinite(w) || wide.confidence.at<float>(y, x) < options.silent_confidence)
+            continue;
+          if (w < lo.at<float>(y, x) - 1 || w > hi.at<float>(y, x) + 1) {
+            d = std::numeric_limits<float>::quiet_NaN();
+            ++outside_band;
+          }
+        }
+    }
     result.disparity_px[level] = dm.disparity_px;
     LevelFigures& fig = result.levels[level];
     fig.level = level;
     fig.rect = rect;
     fig.searched = dm.searched;
-    fig.matched = dm.matched;
+    fig.matched = dm.matched - outside_band;
+    fig.outside_band = outside_band;
     fig.match_time_s = Since(t0);
 
     // Patches over the part of the level not covered by the finer one.
@@ -165,7 +195,8 @@ FovealResult FovealStereo(const rig::StereoFrame& frame, const Eigen::Vector3d& 
 }
 
 FixationResult Fixate(rig::Rig& rig, const PatchMap& map, const Eigen::Vector3d& p_W,
-                      const StereoMatcher& matcher, const FixationOptions& options, int fixation) {
+                      const StereoMatcher& matcher, const FixationOptions& options, int fixation,
+                      const std::optional<DepthRange>& guessed_depths) {
   options.Check();
   FixationResult r;
   const auto t0 = Clock::now();
@@ -179,9 +210,14 @@ FixationResult Fixate(rig::Rig& rig, const PatchMap& map, const Eigen::Vector3d&
   const double verge_s = Since(t0);
   r.verge_time_s = verge_s;
   const auto t_servo = Clock::now();
-  r.servo = Servo(rig, r.vergence.state, options.servo);
+  r.servo = Servo(rig, r.vergence.state, options.servo, guessed_depths);
   r.servo_wall_s = Since(t_servo);
   r.motion_time_s = r.servo.motion_time_s;
+  if (guessed_depths && !r.servo.converged) {
+    r.why = "servoing found no unique match for a point of guessed depth";
+    r.compute_time_s = verge_s;
+    return r;
+  }
   const rig::StereoFrame& frame = r.servo.frame;
   // Where the two optical axes (the principal points' rays) meet.
   const auto& kl = frame.left.intrinsics;

@@ -74,18 +74,19 @@ cv::Mat LocalSuppression::Evaluate(const SelectionContext& c) const {
   for (int y = 0; y < w.rows; ++y)
     for (int x = 0; x < w.cols; ++x) {
       const signed char level = c.map_level.at<signed char>(y, x);
-      if (level == static_cast<signed char>(PatchLevel::kFoveal)) {
-        w.at<double>(y, x) = low_;
-        continue;
-      }
-      if (level == static_cast<signed char>(PatchLevel::kPeripheral)) w.at<double>(y, x) = peripheral_;
+      double& wp = w.at<double>(y, x);
+      if (level == static_cast<signed char>(PatchLevel::kFoveal)) wp = low_;
+      if (level == static_cast<signed char>(PatchLevel::kPeripheral)) wp = peripheral_;
       if (c.fixated_W.empty() || c.map_depth_m.at<float>(y, x) <= 0) continue;
       const Eigen::Vector3d p = c.MapPoint(x, y);
-      for (const Eigen::Vector3d& f : c.fixated_W)
-        if ((p - f).norm() < radius_) {
-          w.at<double>(y, x) = low_;
+      for (const Eigen::Vector3d& f : c.fixated_W) {
+        const double r = (p - f).norm();
+        if (r < revisit_) {
+          wp = 0;
           break;
         }
+        if (r < radius_) wp = std::min(wp, low_);
+      }
     }
   NormalizeSum(&w);
   return w;

@@ -10,6 +10,7 @@ void ServoOptions::Check() const {
   if (search_px < 1 || search_px > 300) throw std::invalid_argument("servo: search_px must be 1 to 300");
   if (!(tolerance_px > 0)) throw std::invalid_argument("servo: tolerance_px must be positive");
   if (max_steps < 1) throw std::invalid_argument("servo: max_steps must be >= 1");
+  if (!(unique_ratio > 0 && unique_ratio <= 1)) throw std::invalid_argument("servo: unique_ratio must be in (0, 1]");
 }
 
 double NormalizedL1(const cv::Mat& left, int xl, int yl, const cv::Mat& right, int xr, int yr, int half) {
@@ -33,32 +34,79 @@ double NormalizedL1(const cv::Mat& left, int xl, int yl, const cv::Mat& right, i
   return cost / n;
 }
 
-std::optional<double> CentreDisparity(const rig::StereoFrame& frame, const ServoOptions& o) {
+namespace {
+
+// The normalized L1 search of the left centre window along the right image's
+// row, over right-image offsets [lo, hi] pixels from the right principal
+// point; the minimum is refined by a parabola. A minimum at the edge of the
+// search is no match, and with `unique_ratio` < 1 neither is one whose cost
+// is not below that share of the best minimum elsewhere (outside the best's
+// window half-width).
+std::optional<double> SearchRow(const rig::StereoFrame& frame, const ServoOptions& o, int lo, int hi,
+                                double unique_ratio) {
   const cv::Mat& l = frame.left.gray;
   const cv::Mat& r = frame.right.gray;
   const int xl = static_cast<int>(std::lround(frame.left.intrinsics.cx_px));
   const int yl = static_cast<int>(std::lround(frame.left.intrinsics.cy_px));
   const int xr0 = static_cast<int>(std::lround(frame.right.intrinsics.cx_px));
   const int h = o.window_half_px;
+  if (xl - h < 0 || yl - h < 0 || xl + h >= l.cols || yl + h >= l.rows || hi <= lo) return std::nullopt;
   // No texture in the left window: nothing to servo on.
-  if (xl - h < 0 || yl - h < 0 || xl + h >= l.cols || yl + h >= l.rows) return std::nullopt;
   if (NormalizedL1(l, xl, yl, cv::Mat(l.size(), CV_8U, cv::Scalar(0)), xl, yl, h) < 2.0) return std::nullopt;
-  std::vector<double> cost(2 * o.search_px + 1, 1e300);
+  const int n = hi - lo + 1;
+  std::vector<double> cost(n, 1e300);
   int best = -1;
-  for (int i = 0; i <= 2 * o.search_px; ++i) {
-    const int xr = xr0 - o.search_px + i;
+  for (int i = 0; i < n; ++i) {
+    const int xr = xr0 + lo + i;
     if (xr - h < 0 || xr + h >= r.cols) continue;
     cost[i] = NormalizedL1(l, xl, yl, r, xr, yl, h);
     if (best < 0 || cost[i] < cost[best]) best = i;
   }
-  if (best <= 0 || best >= 2 * o.search_px) return std::nullopt;
+  if (best <= 0 || best >= n - 1 || cost[best - 1] >= 1e300 || cost[best + 1] >= 1e300) return std::nullopt;
+  if (unique_ratio < 1) {
+    for (int i = 1; i + 1 < n; ++i) {
+      const bool local_min = cost[i] <= cost[i - 1] && cost[i] <= cost[i + 1] && cost[i] < 1e300;
+      if (local_min && std::abs(i - best) > h && cost[best] >= unique_ratio * cost[i]) return std::nullopt;
+    }
+  }
   const double c0 = cost[best - 1], c1 = cost[best], c2 = cost[best + 1];
   const double denom = c0 - 2 * c1 + c2;
   const double sub = denom > 0 ? 0.5 * (c0 - c2) / denom : 0.0;
-  return (xr0 - o.search_px + best + sub) - frame.right.intrinsics.cx_px;
+  return (xr0 + lo + best + sub) - frame.right.intrinsics.cx_px;
 }
 
-ServoResult Servo(rig::Rig& rig, const rig::StageState& start, const ServoOptions& o) {
+}  // namespace
+
+std::optional<double> CentreDisparity(const rig::StereoFrame& frame, const ServoOptions& o) {
+  return SearchRow(frame, o, -o.search_px, o.search_px, 1.0);
+}
+
+std::optional<double> CentreDisparity(const rig::StereoFrame& frame, const ServoOptions& o, const DepthRange& depths) {
+  if (!(depths.near_m > 0) || !(depths.far_m >= depths.near_m))
+    throw std::invalid_argument("servo: depth range must have 0 < near_m <= far_m");
+  const Eigen::Isometry3d right_T_left = frame.right.world_T_camera.inverse() * frame.left.world_T_camera;
+  const rig::CameraIntrinsics& kl = frame.left.intrinsics;
+  const rig::CameraIntrinsics& kr = frame.right.intrinsics;
+  const Eigen::Vector3d axis = kl.Ray({kl.cx_px, kl.cy_px});
+  double lo = 1e300, hi = -1e300;
+  for (const double z : {depths.near_m, depths.far_m}) {
+    const Eigen::Vector3d p_R = right_T_left * (z * axis);
+    if (p_R.z() <= 1e-6) continue;  // behind the right camera: the search ends at the image edge
+    const double offset = kr.fx_px * p_R.x() / p_R.z();
+    lo = std::min(lo, offset);
+    hi = std::max(hi, offset);
+  }
+  if (lo > hi) return std::nullopt;
+  // Within the image: a window centred further out could not be compared.
+  const double edge = std::max(kr.cx_px, kr.width_px - kr.cx_px);
+  lo = std::max(lo, -edge);
+  hi = std::min(hi, edge);
+  return SearchRow(frame, o, static_cast<int>(std::floor(lo)) - 1, static_cast<int>(std::ceil(hi)) + 1,
+                   o.unique_ratio);
+}
+
+ServoResult Servo(rig::Rig& rig, const rig::StageState& start, const ServoOptions& o,
+                  const std::optional<DepthRange>& first_depths) {
   o.Check();
   ServoResult result;
   rig::StageState state = start;
@@ -66,7 +114,8 @@ ServoResult Servo(rig::Rig& rig, const rig::StageState& start, const ServoOption
   for (int step = 0;; ++step) {
     result.frame = rig.Capture();
     result.state = result.frame.state;
-    const auto d = CentreDisparity(result.frame, o);
+    const auto d = step == 0 && first_depths ? CentreDisparity(result.frame, o, *first_depths)
+                                             : CentreDisparity(result.frame, o);
     if (!d) break;
     result.residual_px = *d;
     result.residuals_px.push_back(*d);

@@ -30,6 +30,7 @@ struct CriteriaOptions {
   double suppressed_weight = 0.02;  ///< local suppression's weight on foveal data
   double suppression_radius_m = 0.08;  ///< and within this distance of an earlier fixation
   double peripheral_weight = 0.3;   ///< local suppression's weight on peripheral data (paper: 1)
+  double revisit_radius_m = 0.03;   ///< local suppression's weight is 0 this close to an earlier fixation
   double proximity_2d_scale_px = 320;
   double proximity_3d_low = 0.1;    ///< 3D proximity's weight outside the Z_T band
   void Check() const;

@@ -27,6 +27,15 @@ struct FovealOptions {
                             /*require_quadrants=*/true};
   double map_margin_px = 2.0;   ///< search +- this many level pixels around the map's prediction
   double coarse_margin_px = 1.5;  ///< and around the coarser level's estimate
+  /// Where the map is silent and no coarser estimate exists, the paper
+  /// searches the Z_T band about the fixation depth, which takes a false
+  /// match in the band for a surface outside it. With this > 0 such pixels
+  /// are also searched over every depth from this many metres to infinity,
+  /// and a band match is dropped where that wider search matched outside the
+  /// band with at least `silent_confidence` (a repeated texture's copies
+  /// leave its confidence low: the band's prior stands).
+  double silent_near_m = 0.4;
+  double silent_confidence = 0.2;
   void Check() const;
 };
 
@@ -35,6 +44,7 @@ struct LevelFigures {
   int level = 0;
   cv::Rect rect;            ///< full-resolution pixels the level covers
   int searched = 0, matched = 0, patches = 0;
+  int outside_band = 0;     ///< band matches dropped: the wider search matched outside (FovealOptions::silent_near_m)
   double match_time_s = 0;
 };
 
@@ -74,8 +84,13 @@ struct FixationResult {
   double servo_wall_s = 0;  ///< the servo loop: moves, captures and measurements, wall clock
 };
 
-/// Verges on p_W, servos, captures and runs the foveated stereo.
+/// Verges on p_W, servos, captures and runs the foveated stereo. Given
+/// `guessed_depths`, p_W's depth is only a guess (a hole in the map): the
+/// servo's first search spans those depths, and a servo that does not
+/// converge leaves the point not fixable (the foveated stage would search
+/// around a depth nobody measured).
 FixationResult Fixate(rig::Rig& rig, const PatchMap& map, const Eigen::Vector3d& p_W,
-                      const StereoMatcher& matcher, const FixationOptions& options, int fixation = 0);
+                      const StereoMatcher& matcher, const FixationOptions& options, int fixation = 0,
+                      const std::optional<DepthRange>& guessed_depths = std::nullopt);
 
 }  // namespace fovea

@@ -8,6 +8,11 @@
 
 namespace fovea {
 
+/// A depth that stands for infinity in disparity searches: a point this far
+/// is within a tenth of a pixel of the point at infinity for any focal length
+/// under 2,000 px and baseline under 4 m.
+constexpr double kFarDepthM = 1e5;
+
 /// Pixel where the world point p_W appears in a camera at world_T_camera;
 /// nullopt if the point is behind or on the camera plane.
 std::optional<Eigen::Vector2d> ProjectWorldPoint(const Eigen::Isometry3d& world_T_camera,

@@ -30,7 +30,7 @@ struct SelectionContext {
   bool has_fixation = false;    ///< false before the first vergent fixation
   double fixation_depth_m = 0;  ///< depth of the current fixation point in the view
   double z_t_near_m = 0, z_t_far_m = 0;  ///< the current fovea's depth band (Z_T)
-  std::vector<Eigen::Vector3d> fixated_W;  ///< earlier fixation points
+  std::vector<Eigen::Vector3d> fixated_W;  ///< earlier fixation points (and holes' guessed points aimed at)
   /// If set, only points that this view sees (the IDR view: the region the
   /// run maps) are candidates.
   std::optional<rig::CameraView> region;
@@ -73,17 +73,21 @@ class GradientAttraction : public FixationCriterion {
 /// elsewhere. Beyond the paper, `peripheral_weight` grades the suppression:
 /// the weight where the map holds peripheral data (1 = the paper's rule, which
 /// suppresses foveal data only), so that the eye prefers what is mapped
-/// coarsely or not at all.
+/// coarsely or not at all. Within `revisit_radius_m` of an earlier fixation
+/// point the weight is 0: the scene is static, and a second look at the same
+/// point from the same rig sees what the first saw (a fixation at a depth
+/// edge, whose fovea yields nothing, kept drawing the eye back with any
+/// weight above 0).
 class LocalSuppression : public FixationCriterion {
  public:
   explicit LocalSuppression(double suppressed_weight = 0.02, double radius_m = 0.04,
-                            double peripheral_weight = 1.0)
-      : low_(suppressed_weight), radius_(radius_m), peripheral_(peripheral_weight) {}
+                            double peripheral_weight = 1.0, double revisit_radius_m = 0)
+      : low_(suppressed_weight), radius_(radius_m), peripheral_(peripheral_weight), revisit_(revisit_radius_m) {}
   std::string Name() const override { return "suppression"; }
   cv::Mat Evaluate(const SelectionContext& context) const override;
 
  private:
-  double low_, radius_, peripheral_;
+  double low_, radius_, peripheral_, revisit_;
 };
 
 /// exp(-r / s), r the distance from the image centre in pixels.

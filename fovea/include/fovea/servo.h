@@ -21,7 +21,16 @@ struct ServoOptions {
   int search_px = 40;          ///< horizontal search +- this many pixels
   double tolerance_px = 0.5;   ///< done when the residual disparity is below this
   int max_steps = 6;           ///< step budget
+  /// A search over a depth range (see Servo) keeps its best match only if
+  /// its cost is below this share of the best match elsewhere (a repeated
+  /// texture's other copies): 1 keeps any minimum.
+  double unique_ratio = 0.85;
   void Check() const;
+};
+
+/// Depths along the left optical axis, metres.
+struct DepthRange {
+  double near_m = 0, far_m = 0;
 };
 
 /// Where the left image's centre window appears in the right image, as a
@@ -30,6 +39,13 @@ struct ServoOptions {
 /// edge of the search or the window has no texture (mean absolute deviation
 /// under 2 grey levels).
 std::optional<double> CentreDisparity(const rig::StereoFrame& frame, const ServoOptions& options);
+
+/// The same over the right-image positions of the points at `depths` on the
+/// left optical axis (their projections, one pixel of margin), keeping the
+/// best match only if it is unique (options.unique_ratio); nullopt also when
+/// it is not.
+std::optional<double> CentreDisparity(const rig::StereoFrame& frame, const ServoOptions& options,
+                                      const DepthRange& depths);
 
 struct ServoResult {
   bool converged = false;
@@ -43,7 +59,11 @@ struct ServoResult {
 
 /// Moves to `start`, then repeats: capture, measure the centre disparity d,
 /// turn the right camera by -atan(d / f), until |d| < tolerance or the step
-/// budget is spent. Throws rig::RigError if the rig refuses a move.
-ServoResult Servo(rig::Rig& rig, const rig::StageState& start, const ServoOptions& options);
+/// budget is spent. The first measurement searches +- search_px about the
+/// start, or, given `first_depths` (the start's depth is a guess), every
+/// position a point at those depths can take. Throws rig::RigError if the
+/// rig refuses a move.
+ServoResult Servo(rig::Rig& rig, const rig::StageState& start, const ServoOptions& options,
+                  const std::optional<DepthRange>& first_depths = std::nullopt);
 
 }  // namespace fovea
