@@ -46,9 +46,9 @@ namespace {
 // A point on the left camera's axis as it fixates p_W, `scale` times as far
 // from the camera: fixating it points the left camera at p_W again, with the
 // depth guessed wrong.
-Eigen::Vector3d OnLeftAxis(rig::Rig& rig, const Eigen::Vector3d& p_W, double scale) {
+Eigen::Vector3d OnLeftAxis(rig::Rig& rig, const Eigen::Vector3d& p_W, double scale, double baseline_m) {
   const auto sol = fovea::Verge(rig.Geometry(), rig.Limits(), rig.Intrinsics(rig::Side::kLeft),
-                                rig.Intrinsics(rig::Side::kRight), rig::StageState::Parallel(0.12), p_W);
+                                rig.Intrinsics(rig::Side::kRight), rig::StageState::Parallel(baseline_m), p_W);
   REQUIRE(sol.ok);
   rig.MoveTo(sol.state);
   const Eigen::Vector3d c = rig.Capture().left.world_T_camera.translation();
@@ -65,17 +65,20 @@ TEST_CASE("a guessed depth: the servo searches every depth and finds the surface
   const fovea::Nl1Matcher matcher;
   const fovea::PatchMap empty;
   // The left wooden block's face at 0.50 m, guessed at 1.2 m (the plywood's
-  // depth, as a hole's nearest mapped neighbour would have it): about 170 px
-  // of disparity, far beyond the +-40 px of the ordinary search.
+  // depth, as a hole's nearest mapped neighbour would have it): at a 0.12 m
+  // baseline about 170 px of disparity, far beyond the +-40 px of the
+  // ordinary search.
+  fovea::FixationOptions o;
+  o.baseline_m = 0.12;
   const Eigen::Vector3d block(-0.11, 0.50, -0.055);
-  const Eigen::Vector3d guess = OnLeftAxis(rig, block, 2.4);
+  const Eigen::Vector3d guess = OnLeftAxis(rig, block, 2.4, o.baseline_m);
   const fovea::DepthRange every{0.4, fovea::kFarDepthM};
-  const fovea::FixationResult wide = fovea::Fixate(rig, empty, guess, matcher, {}, 0, every);
-  INFO("wide: " << wide.why << " fixated at " << wide.fixation_W.transpose());
+  const fovea::FixationResult wide = fovea::Fixate(rig, empty, guess, matcher, o, 0, every);
+  INFO("wide: " << wide.why << " fixated at " << wide.fixation_W.transpose() << " residuals " << [&] { std::string s; for (double d : wide.servo.residuals_px) s += std::to_string(d) + " "; return s; }());
   REQUIRE(wide.ok);
   CHECK(wide.servo.converged);
   CHECK((wide.fixation_W - block).norm() < 0.02);
-  const fovea::FixationResult narrow = fovea::Fixate(rig, empty, guess, matcher, {});
+  const fovea::FixationResult narrow = fovea::Fixate(rig, empty, guess, matcher, o);
   INFO("narrow: fixated at " << narrow.fixation_W.transpose());
   CHECK((narrow.fixation_W - block).norm() > 0.1);
 }
@@ -89,7 +92,7 @@ TEST_CASE("a guessed depth on a periodic texture: no unique match, the point is 
   const fovea::PatchMap empty;
   // The stripes (period about 21 px) at 0.9 m, guessed at 0.6 m: every
   // period in the search matches as well as the true one.
-  const Eigen::Vector3d guess = OnLeftAxis(rig, {0.0, 0.9, 0.0}, 2.0 / 3.0);
+  const Eigen::Vector3d guess = OnLeftAxis(rig, {0.0, 0.9, 0.0}, 2.0 / 3.0, fovea::FixationOptions().baseline_m);
   const fovea::FixationResult r =
       fovea::Fixate(rig, empty, guess, matcher, {}, 0, fovea::DepthRange{0.4, fovea::kFarDepthM});
   CHECK_FALSE(r.ok);

@@ -126,6 +126,7 @@ std::vector<ConfigParam> ConfigParams(RunConfig* c) {
       {"foveal.periphery_patch_px", "patch size at coarser levels, full-resolution pixels (at least 4 pixels of the level)", &f.fixation.foveal.periphery_patch_px, 4, 64},
       {"foveal.silent_near_m", "beyond the paper: where the map is silent, search every depth from this to infinity and keep only matches inside Z_T (0 = the paper's rule: search Z_T only), metres", &f.fixation.foveal.silent_near_m, 0, 10},
       {"foveal.servo_tolerance_px", "servoing stops below this centre disparity, pixels", &f.fixation.servo.tolerance_px, 0.01, 10},
+      {"foveal.servo_search_px", "servoing's first search on a mapped point: +- this many pixels", &f.fixation.servo.search_px, 1, 300},
       {"foveal.servo_unique_ratio", "servoing on a hole searches every depth and keeps its best match only if its cost is below this share of the best elsewhere (1 = any)", &f.fixation.servo.unique_ratio, 0.01, 1},
       {"foveal.silent_confidence", "see foveal.silent_near_m: the wider search's match confidence needed to drop a band match", &f.fixation.foveal.silent_confidence, 0, 1},
       {"foveal.servo_max_steps", "servoing step budget", &f.fixation.servo.max_steps, 0, 50},

@@ -117,8 +117,15 @@ FoveaRun RunFovea(rig::Rig& rig, const StereoMatcher& matcher, const FoveaOption
     // every depth from the nearest the scene allows to infinity.
     const std::optional<DepthRange> guessed =
         rec.selection.in_hole ? std::optional<DepthRange>(DepthRange{options.idr.z_min_m, kFarDepthM}) : std::nullopt;
-    const FixationResult r =
+    FixationResult r =
         Fixate(rig, run.map, rec.target_W, matcher, options.fixation, run.fixations_done + 1, guessed);
+    // Nothing lies nearer than idr.z_min_m: a servo that settled there took
+    // a false match (a repeated texture's copy).
+    if (r.ok && r.foveal.tessellation.fixation_depth_m < options.idr.z_min_m) {
+      r.ok = false;
+      r.why = "servoing settled at " + std::to_string(r.foveal.tessellation.fixation_depth_m) +
+              " m, nearer than idr.z_min_m: a false match";
+    }
     rec.time.verge_s = r.verge_time_s;
     rec.time.servo_s = r.servo_wall_s;
     rec.motion_time_s = r.motion_time_s;

@@ -1,5 +1,6 @@
 #include "fovea/servo.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -8,6 +9,7 @@ namespace fovea {
 void ServoOptions::Check() const {
   if (window_half_px < 2 || window_half_px > 100) throw std::invalid_argument("servo: window_half_px must be 2 to 100");
   if (search_px < 1 || search_px > 300) throw std::invalid_argument("servo: search_px must be 1 to 300");
+  if (refine_px < 1 || refine_px > 300) throw std::invalid_argument("servo: refine_px must be 1 to 300");
   if (!(tolerance_px > 0)) throw std::invalid_argument("servo: tolerance_px must be positive");
   if (max_steps < 1) throw std::invalid_argument("servo: max_steps must be >= 1");
   if (!(unique_ratio > 0 && unique_ratio <= 1)) throw std::invalid_argument("servo: unique_ratio must be in (0, 1]");
@@ -77,8 +79,8 @@ std::optional<double> SearchRow(const rig::StereoFrame& frame, const ServoOption
 
 }  // namespace
 
-std::optional<double> CentreDisparity(const rig::StereoFrame& frame, const ServoOptions& o) {
-  return SearchRow(frame, o, -o.search_px, o.search_px, 1.0);
+std::optional<double> CentreDisparity(const rig::StereoFrame& frame, const ServoOptions& o, int search_px) {
+  return SearchRow(frame, o, -search_px, search_px, 1.0);
 }
 
 std::optional<double> CentreDisparity(const rig::StereoFrame& frame, const ServoOptions& o, const DepthRange& depths) {
@@ -114,8 +116,10 @@ ServoResult Servo(rig::Rig& rig, const rig::StageState& start, const ServoOption
   for (int step = 0;; ++step) {
     result.frame = rig.Capture();
     result.state = result.frame.state;
-    const auto d = step == 0 && first_depths ? CentreDisparity(result.frame, o, *first_depths)
-                                             : CentreDisparity(result.frame, o);
+    const int refine = std::max(o.refine_px, static_cast<int>(std::ceil(std::abs(result.residual_px) / 4)));
+    const auto d = step > 0       ? CentreDisparity(result.frame, o, refine)
+                   : first_depths ? CentreDisparity(result.frame, o, *first_depths)
+                                  : CentreDisparity(result.frame, o, o.search_px);
     if (!d) break;
     result.residual_px = *d;
     result.residuals_px.push_back(*d);

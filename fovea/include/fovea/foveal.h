@@ -68,7 +68,10 @@ struct FixationOptions {
   VergenceOptions vergence;
   ServoOptions servo;
   FovealOptions foveal;
-  double baseline_m = 0.12;  ///< vergent baseline, symmetric about the rail centre
+  /// Vergent baseline, symmetric about the rail centre. A narrow one keeps
+  /// the vergence angle small: a larger fovea and Z_T, and a thinner strip
+  /// of surface hidden from the right camera beside a nearer surface's edge.
+  double baseline_m = 0.04;
   void Check() const;
 };
 

@@ -18,7 +18,10 @@ double NormalizedL1(const cv::Mat& left, int xl, int yl, const cv::Mat& right, i
 
 struct ServoOptions {
   int window_half_px = 15;     ///< a 31 x 31 window
-  int search_px = 40;          ///< horizontal search +- this many pixels
+  int search_px = 40;          ///< first measurement: horizontal search +- this many pixels
+  /// Later measurements, after a move that nulled the last one d: +- the
+  /// larger of this and |d| / 4 (a move is good to a few per cent).
+  int refine_px = 8;
   double tolerance_px = 0.5;   ///< done when the residual disparity is below this
   int max_steps = 6;           ///< step budget
   /// A search over a depth range (see Servo) keeps its best match only if
@@ -33,12 +36,14 @@ struct DepthRange {
   double near_m = 0, far_m = 0;
 };
 
-/// Where the left image's centre window appears in the right image, as a
-/// horizontal offset in pixels from the right principal point (sub-pixel by
+/// Where the left image's centre window appears in the right image, searched
+/// +- search_px about the right principal point, as a horizontal offset in
+/// pixels from it (sub-pixel by
 /// a parabola through the cost minimum); nullopt if the minimum is at the
 /// edge of the search or the window has no texture (mean absolute deviation
 /// under 2 grey levels).
-std::optional<double> CentreDisparity(const rig::StereoFrame& frame, const ServoOptions& options);
+std::optional<double> CentreDisparity(const rig::StereoFrame& frame, const ServoOptions& options,
+                                      int search_px);
 
 /// The same over the right-image positions of the points at `depths` on the
 /// left optical axis (their projections, one pixel of margin), keeping the
