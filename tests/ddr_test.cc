@@ -75,7 +75,7 @@ TEST_CASE("fovea run: the same seed gives the same run, another seed another one
   for (const auto& d : {a, b, c}) fs::remove_all(d);
 }
 
-TEST_CASE("fovea run on two_planes: near plane first, then the far one; outputs and summary keys", "[ddr][slow]") {
+TEST_CASE("fovea run on two_planes: near plane first, then the far one, with its outputs and summary keys", "[ddr][slow]") {
   const fs::path out = Out("two");
   RunFovea("--scene two_planes", out);
   const auto records = Records(out);
@@ -102,7 +102,7 @@ TEST_CASE("fovea run on two_planes: near plane first, then the far one; outputs 
   const double f1 = records.front()["score"]["foveal_coverage"], f25 = records.back()["score"]["foveal_coverage"];
   CHECK(f25 > f1);
   CHECK(s["median_rel_error"].get<double>() < 0.01);
-  CHECK(s["coverage"].get<double>() > 0.8);  // measured 0.87; the issue asks 0.95 (not yet met)
+  CHECK(s["coverage"].get<double>() >= 0.95);  // measured 0.989
   fs::remove_all(out);
 }
 

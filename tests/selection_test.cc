@@ -67,7 +67,7 @@ TEST_CASE("the exponential draw favours high values with the scale asked for", "
   CHECK(fovea::DrawExponential(0.5, 0.1) < fovea::DrawExponential(0.5, 0.5));
 }
 
-TEST_CASE("selection: deterministic takes the maximum; draws are reproducible from the seed", "[fovea][selection]") {
+TEST_CASE("selection: deterministic takes the maximum, and draws are reproducible from the seed", "[fovea][selection]") {
   fovea::PatchMap map;
   map.Add(Square(-1, 0, -1, 1, 1.0, fovea::PatchLevel::kFoveal));
   map.Add(Square(0, 1, -1, 1, 1.0, fovea::PatchLevel::kIdr));

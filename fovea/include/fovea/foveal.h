@@ -71,7 +71,7 @@ struct FixationOptions {
   /// Vergent baseline, symmetric about the rail centre. A narrow one keeps
   /// the vergence angle small: a larger fovea and Z_T, and a thinner strip
   /// of surface hidden from the right camera beside a nearer surface's edge.
-  double baseline_m = 0.04;
+  double baseline_m = 0.06;
   void Check() const;
 };
 
