@@ -1,6 +1,8 @@
 // Visual servoing on the simulated rig, noise on.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <memory>
+#include <string>
 
 #include "fovea/foveal.h"
 #include "fovea/geometry.h"
@@ -8,40 +10,21 @@
 #include "fovea/vergence.h"
 #include "scenes/catalog.h"
 
-TEST_CASE("servoing converges from 20 px off within 6 steps", "[fovea][servo][slow]") {
+namespace {
+
+// A catalog scene with sensor noise on (2 grey levels).
+std::unique_ptr<sim::Simulation> NoisyScene(const std::string& name) {
   sim::SimRigConfig config;
   config.noise.read_noise_sigma_dn = 2.0;
-  struct Point {
-    std::string scene;
-    Eigen::Vector3d p_W;
-  };
-  const std::vector<Point> points = {{"cylinder_planes", {0.0, 0.89, 0.0}},
-                                     {"cylinder_planes", {-0.2, 0.93, 0.05}},
-                                     {"cylinder_planes", {0.25, 1.0, -0.05}},
-                                     {"three_surfaces", {-0.05, 0.53, -0.055}},
-                                     {"three_surfaces", {0.09, 0.86, 0.05}},
-                                     {"three_surfaces", {-0.25, 1.2, 0.1}}};
-  for (const Point& pt : points) {
-    INFO(pt.scene << " " << pt.p_W.transpose());
-    auto sim = scenes::LoadScene(pt.scene, config);
-    rig::Rig& rig = sim->rig();
-    const auto sol = fovea::Verge(rig.Geometry(), rig.Limits(), rig.Intrinsics(rig::Side::kLeft),
-                                  rig.Intrinsics(rig::Side::kRight), rig::StageState::Parallel(0.12), pt.p_W);
-    REQUIRE(sol.ok);
-    rig::StageState start = sol.state;
-    const double f = rig.Intrinsics(rig::Side::kRight).fx_px;
-    start.right.pan_rad += std::atan(20.0 / f);  // the point 20 px off centre
-    const fovea::ServoResult r = fovea::Servo(rig, start, {});
-    INFO("residuals: " << [&] { std::string s; for (double d : r.residuals_px) s += std::to_string(d) + " "; return s; }());
-    REQUIRE_FALSE(r.residuals_px.empty());
-    CHECK(std::abs(std::abs(r.residuals_px.front()) - 20) < 2);  // it did start 20 px off
-    CHECK(r.converged);
-    CHECK(std::abs(r.residual_px) < 0.5);
-    CHECK(r.iterations <= 6);
-  }
+  return scenes::LoadScene(name, config);
 }
 
-namespace {
+// The servo's measured residuals, for a failure's message.
+std::string Residuals(const fovea::ServoResult& r) {
+  std::string s;
+  for (double d : r.residuals_px) s += std::to_string(d) + " ";
+  return s;
+}
 
 // A point on the left camera's axis as it fixates p_W, `scale` times as far
 // from the camera: fixating it points the left camera at p_W again, with the
@@ -55,12 +38,44 @@ Eigen::Vector3d OnLeftAxis(rig::Rig& rig, const Eigen::Vector3d& p_W, double sca
   return c + scale * (p_W - c);
 }
 
+// Every depth from the scenes' nearest (idr.z_min_m's default) to infinity.
+const fovea::DepthRange kEveryDepth{0.4, fovea::kFarDepthM};
+
 }  // namespace
 
+TEST_CASE("servoing converges from 20 px off within 6 steps", "[fovea][servo][slow]") {
+  struct Point {
+    std::string scene;
+    Eigen::Vector3d p_W;
+  };
+  const std::vector<Point> points = {{"cylinder_planes", {0.0, 0.89, 0.0}},
+                                     {"cylinder_planes", {-0.2, 0.93, 0.05}},
+                                     {"cylinder_planes", {0.25, 1.0, -0.05}},
+                                     {"three_surfaces", {-0.05, 0.53, -0.055}},
+                                     {"three_surfaces", {0.09, 0.86, 0.05}},
+                                     {"three_surfaces", {-0.25, 1.2, 0.1}}};
+  for (const Point& pt : points) {
+    INFO(pt.scene << " " << pt.p_W.transpose());
+    auto sim = NoisyScene(pt.scene);
+    rig::Rig& rig = sim->rig();
+    const auto sol = fovea::Verge(rig.Geometry(), rig.Limits(), rig.Intrinsics(rig::Side::kLeft),
+                                  rig.Intrinsics(rig::Side::kRight), rig::StageState::Parallel(0.12), pt.p_W);
+    REQUIRE(sol.ok);
+    rig::StageState start = sol.state;
+    const double f = rig.Intrinsics(rig::Side::kRight).fx_px;
+    start.right.pan_rad += std::atan(20.0 / f);  // the point 20 px off centre
+    const fovea::ServoResult r = fovea::Servo(rig, start, {});
+    INFO("residuals: " << Residuals(r));
+    REQUIRE_FALSE(r.residuals_px.empty());
+    CHECK(std::abs(std::abs(r.residuals_px.front()) - 20) < 2);  // it did start 20 px off
+    CHECK(r.converged);
+    CHECK(std::abs(r.residual_px) < 0.5);
+    CHECK(r.iterations <= 6);
+  }
+}
+
 TEST_CASE("a guessed depth: the servo searches every depth and finds the surface", "[fovea][servo][slow]") {
-  sim::SimRigConfig config;
-  config.noise.read_noise_sigma_dn = 2.0;
-  auto sim = scenes::LoadScene("three_surfaces", config);
+  auto sim = NoisyScene("three_surfaces");
   rig::Rig& rig = sim->rig();
   const fovea::Nl1Matcher matcher;
   const fovea::PatchMap empty;
@@ -72,9 +87,9 @@ TEST_CASE("a guessed depth: the servo searches every depth and finds the surface
   o.baseline_m = 0.12;
   const Eigen::Vector3d block(-0.11, 0.50, -0.055);
   const Eigen::Vector3d guess = OnLeftAxis(rig, block, 2.4, o.baseline_m);
-  const fovea::DepthRange every{0.4, fovea::kFarDepthM};
-  const fovea::FixationResult wide = fovea::Fixate(rig, empty, guess, matcher, o, 0, every);
-  INFO("wide: " << wide.why << " fixated at " << wide.fixation_W.transpose() << " residuals " << [&] { std::string s; for (double d : wide.servo.residuals_px) s += std::to_string(d) + " "; return s; }());
+  const fovea::FixationResult wide = fovea::Fixate(rig, empty, guess, matcher, o, 0, kEveryDepth);
+  INFO("wide: " << wide.why << " fixated at " << wide.fixation_W.transpose() << ", residuals "
+                << Residuals(wide.servo));
   REQUIRE(wide.ok);
   CHECK(wide.servo.converged);
   CHECK((wide.fixation_W - block).norm() < 0.02);
@@ -84,17 +99,14 @@ TEST_CASE("a guessed depth: the servo searches every depth and finds the surface
 }
 
 TEST_CASE("a guessed depth on a periodic texture: no unique match, the point is refused", "[fovea][servo][slow]") {
-  sim::SimRigConfig config;
-  config.noise.read_noise_sigma_dn = 2.0;
-  auto sim = scenes::LoadScene("periodic", config);
+  auto sim = NoisyScene("periodic");
   rig::Rig& rig = sim->rig();
   const fovea::Nl1Matcher matcher;
   const fovea::PatchMap empty;
   // The stripes (period about 21 px) at 0.9 m, guessed at 0.6 m: every
   // period in the search matches as well as the true one.
   const Eigen::Vector3d guess = OnLeftAxis(rig, {0.0, 0.9, 0.0}, 2.0 / 3.0, fovea::FixationOptions().baseline_m);
-  const fovea::FixationResult r =
-      fovea::Fixate(rig, empty, guess, matcher, {}, 0, fovea::DepthRange{0.4, fovea::kFarDepthM});
+  const fovea::FixationResult r = fovea::Fixate(rig, empty, guess, matcher, {}, 0, kEveryDepth);
   CHECK_FALSE(r.ok);
   CHECK(r.why.find("unique") != std::string::npos);
   CHECK(r.foveal.patches.size() == 0);

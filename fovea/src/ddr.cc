@@ -8,7 +8,6 @@
 namespace fovea {
 namespace {
 
-
 // Share of the view's pixels where the map shows foveal data.
 double FovealShare(const PatchMap& map, const rig::CameraView& view) {
   cv::Mat ids;
@@ -81,6 +80,10 @@ FoveaRun RunFovea(rig::Rig& rig, const StereoMatcher& matcher, const FoveaOption
   Tessellation current;
   std::vector<Eigen::Vector3d> refused, fixated;
   std::vector<double> share_history;
+  // Nothing lies nearer than idr.z_min_m: a fixation the servo settles
+  // nearer is refused.
+  FixationOptions fixation_options = options.fixation;
+  fixation_options.min_depth_m = options.idr.z_min_m;
   const int max_attempts = options.fixations * options.attempts_per_fixation;
   run.stop_reason = "done: " + std::to_string(options.fixations) + " fixations";
   for (int attempt = 1; run.fixations_done < options.fixations; ++attempt) {
@@ -117,15 +120,8 @@ FoveaRun RunFovea(rig::Rig& rig, const StereoMatcher& matcher, const FoveaOption
     // every depth from the nearest the scene allows to infinity.
     const std::optional<DepthRange> guessed =
         rec.selection.in_hole ? std::optional<DepthRange>(DepthRange{options.idr.z_min_m, kFarDepthM}) : std::nullopt;
-    FixationResult r =
-        Fixate(rig, run.map, rec.target_W, matcher, options.fixation, run.fixations_done + 1, guessed);
-    // Nothing lies nearer than idr.z_min_m: a servo that settled there took
-    // a false match (a repeated texture's copy).
-    if (r.ok && r.foveal.tessellation.fixation_depth_m < options.idr.z_min_m) {
-      r.ok = false;
-      r.why = "servoing settled at " + std::to_string(r.foveal.tessellation.fixation_depth_m) +
-              " m, nearer than idr.z_min_m: a false match";
-    }
+    const FixationResult r =
+        Fixate(rig, run.map, rec.target_W, matcher, fixation_options, run.fixations_done + 1, guessed);
     rec.time.verge_s = r.verge_time_s;
     rec.time.servo_s = r.servo_wall_s;
     rec.motion_time_s = r.motion_time_s;

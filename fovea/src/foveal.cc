@@ -9,20 +9,6 @@
 #include "fovea/timing.h"
 
 namespace fovea {
-namespace {
-
-
-// Full-resolution horizontal disparity of the point at planar depth z on the
-// left ray through (u, v).
-double DisparityAtDepth(const rig::CameraView& left, const rig::CameraView& right,
-                        const Eigen::Isometry3d& right_T_left, double u, double v, double z) {
-  const Eigen::Vector3d p_R = right_T_left * (z * left.intrinsics.Ray({u, v}));
-  if (p_R.z() <= 1e-6) return std::numeric_limits<double>::quiet_NaN();
-  const double ur = right.intrinsics.fx_px * p_R.x() / p_R.z() + right.intrinsics.cx_px;
-  return u - ur;
-}
-
-}  // namespace
 
 void FovealOptions::Check() const {
   tessellation.Check();
@@ -36,6 +22,7 @@ void FixationOptions::Check() const {
   servo.Check();
   foveal.Check();
   if (!(baseline_m > 0)) throw std::invalid_argument("fixation: baseline_m must be positive");
+  if (!(min_depth_m >= 0)) throw std::invalid_argument("fixation: min_depth_m must be >= 0");
 }
 
 FovealResult FovealStereo(const rig::StereoFrame& frame, const Eigen::Vector3d& fixation_W,
@@ -115,6 +102,13 @@ FovealResult FovealStereo(const rig::StereoFrame& frame, const Eigen::Vector3d& 
     // a false match of a surface the band does not hold: dropped.
     int outside_band = 0;
     if (options.silent_near_m > 0) {
+      // Only where the band matched is there anything to drop.
+      for (int y = 0; y < l.rows; ++y)
+        for (int x = 0; x < l.cols; ++x)
+          if (!std::isfinite(dm.disparity_px.at<float>(y, x))) {
+            wide_lo.at<float>(y, x) = 1;  // lo > hi: not searched
+            wide_hi.at<float>(y, x) = 0;
+          }
       const DisparityMap wide = matcher.Match(l, r, wide_lo, wide_hi);
       for (int y = 0; y < l.rows; ++y)
         for (int x = 0; x < l.cols; ++x) {
@@ -225,6 +219,12 @@ FixationResult Fixate(rig::Rig& rig, const PatchMap& map, const Eigen::Vector3d&
   const auto meet = TriangulateMidpoint(PixelRay(frame.left.world_T_camera, kl, {kl.cx_px, kl.cy_px}),
                                         PixelRay(frame.right.world_T_camera, kr, {kr.cx_px, kr.cy_px}));
   r.fixation_W = meet ? meet->p_W : p_W;
+  const double depth = (frame.left.world_T_camera.inverse() * r.fixation_W).z();
+  if (depth < options.min_depth_m) {
+    r.why = "servoing settled at " + std::to_string(depth) + " m, nearer than idr.z_min_m: a false match";
+    r.compute_time_s = verge_s;
+    return r;
+  }
   r.foveal = FovealStereo(frame, r.fixation_W, map, matcher, options.foveal, fixation);
   r.compute_time_s = verge_s + r.foveal.compute_time_s;
   r.ok = true;

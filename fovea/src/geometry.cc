@@ -1,5 +1,7 @@
 #include "fovea/geometry.h"
 
+#include <limits>
+
 namespace fovea {
 
 std::optional<Eigen::Vector2d> ProjectWorldPoint(const Eigen::Isometry3d& world_T_camera,
@@ -29,6 +31,14 @@ std::optional<Triangulation> TriangulateMidpoint(const Ray& a, const Ray& b) {
   const Eigen::Vector3d pa = a.origin_W + s * a.direction_W;
   const Eigen::Vector3d pb = b.origin_W + t * b.direction_W;
   return Triangulation{0.5 * (pa + pb), (pa - pb).norm()};
+}
+
+double DisparityAtDepth(const rig::CameraView& left, const rig::CameraView& right,
+                        const Eigen::Isometry3d& right_T_left, double u, double v, double z) {
+  const Eigen::Vector3d p_R = right_T_left * (z * left.intrinsics.Ray({u, v}));
+  if (p_R.z() <= 1e-6) return std::numeric_limits<double>::quiet_NaN();
+  const double ur = right.intrinsics.fx_px * p_R.x() / p_R.z() + right.intrinsics.cx_px;
+  return u - ur;
 }
 
 }  // namespace fovea

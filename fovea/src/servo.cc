@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "fovea/geometry.h"
+
 namespace fovea {
 
 void ServoOptions::Check() const {
@@ -89,12 +91,12 @@ std::optional<double> CentreDisparity(const rig::StereoFrame& frame, const Servo
   const Eigen::Isometry3d right_T_left = frame.right.world_T_camera.inverse() * frame.left.world_T_camera;
   const rig::CameraIntrinsics& kl = frame.left.intrinsics;
   const rig::CameraIntrinsics& kr = frame.right.intrinsics;
-  const Eigen::Vector3d axis = kl.Ray({kl.cx_px, kl.cy_px});
   double lo = 1e300, hi = -1e300;
   for (const double z : {depths.near_m, depths.far_m}) {
-    const Eigen::Vector3d p_R = right_T_left * (z * axis);
-    if (p_R.z() <= 1e-6) continue;  // behind the right camera: the search ends at the image edge
-    const double offset = kr.fx_px * p_R.x() / p_R.z();
+    const double d = DisparityAtDepth(frame.left, frame.right, right_T_left, kl.cx_px, kl.cy_px, z);
+    if (!std::isfinite(d)) continue;  // behind the right camera: the search ends at the image edge
+    // Where the point appears in the right image, from its principal point.
+    const double offset = kl.cx_px - d - kr.cx_px;
     lo = std::min(lo, offset);
     hi = std::max(hi, offset);
   }

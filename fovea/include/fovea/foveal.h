@@ -72,6 +72,10 @@ struct FixationOptions {
   /// the vergence angle small: a larger fovea and Z_T, and a thinner strip
   /// of surface hidden from the right camera beside a nearer surface's edge.
   double baseline_m = 0.06;
+  /// Nothing in the scene lies nearer (planar depth in the left camera): a
+  /// servo that settles nearer took a false match (a repeated texture's
+  /// copy) and the point is refused before any matching (0: no check).
+  double min_depth_m = 0;
   void Check() const;
 };
 

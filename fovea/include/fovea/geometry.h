@@ -29,6 +29,13 @@ struct Ray {
 Ray PixelRay(const Eigen::Isometry3d& world_T_camera, const rig::CameraIntrinsics& intrinsics,
              const Eigen::Vector2d& uv);
 
+/// Full-resolution horizontal disparity u - u_right of the point at planar
+/// depth z on the left camera's ray through pixel (u, v), in a pair whose
+/// right camera is at right_T_left from the left one; NaN if the point is
+/// behind or on the right camera's plane.
+double DisparityAtDepth(const rig::CameraView& left, const rig::CameraView& right,
+                        const Eigen::Isometry3d& right_T_left, double u, double v, double z);
+
 /// Midpoint of the shortest segment between two rays, and that segment's
 /// length (the rays' miss distance). nullopt for (near) parallel rays or a
 /// point behind either camera.
