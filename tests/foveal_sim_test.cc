@@ -53,6 +53,7 @@ TEST_CASE("where the map is silent, a surface outside Z_T gives no false patches
     auto sim = scenes::LoadScene("three_surfaces", config);
     fovea::FixationOptions o;
     o.baseline_m = 0.12;  // Z_T about -0.15 / +0.2 m around 1.2 m: the blocks far outside it
+    o.choose_placement = false;  // carriages symmetric, as measured
     o.foveal.silent_near_m = silent_near_m;
     const fovea::Nl1Matcher matcher;
     const fovea::FixationResult r = fovea::Fixate(sim->rig(), fovea::PatchMap(), {-0.25, 1.2, -0.1}, matcher, o);

@@ -85,6 +85,7 @@ TEST_CASE("a guessed depth: the servo searches every depth and finds the surface
   // ordinary search.
   fovea::FixationOptions o;
   o.baseline_m = 0.12;
+  o.choose_placement = false;  // the symmetric carriages OnLeftAxis assumes
   const Eigen::Vector3d block(-0.11, 0.50, -0.055);
   const Eigen::Vector3d guess = OnLeftAxis(rig, block, 2.4, o.baseline_m);
   const fovea::FixationResult wide = fovea::Fixate(rig, empty, guess, matcher, o, 0, kEveryDepth);
@@ -105,8 +106,10 @@ TEST_CASE("a guessed depth on a periodic texture: no unique match, the point is 
   const fovea::PatchMap empty;
   // The stripes (period about 21 px) at 0.9 m, guessed at 0.6 m: every
   // period in the search matches as well as the true one.
-  const Eigen::Vector3d guess = OnLeftAxis(rig, {0.0, 0.9, 0.0}, 2.0 / 3.0, fovea::FixationOptions().baseline_m);
-  const fovea::FixationResult r = fovea::Fixate(rig, empty, guess, matcher, {}, 0, kEveryDepth);
+  fovea::FixationOptions o;
+  o.choose_placement = false;  // the symmetric carriages OnLeftAxis assumes
+  const Eigen::Vector3d guess = OnLeftAxis(rig, {0.0, 0.9, 0.0}, 2.0 / 3.0, o.baseline_m);
+  const fovea::FixationResult r = fovea::Fixate(rig, empty, guess, matcher, o, 0, kEveryDepth);
   CHECK_FALSE(r.ok);
   CHECK(r.why.find("unique") != std::string::npos);
   CHECK(r.foveal.patches.size() == 0);

@@ -63,6 +63,7 @@ nlohmann::json RecordJson(const fovea::FixationRecord& r, const MapScore& score)
     const auto a = r.state.ToArray();
     j["stage_state"] = {{"left_baseline_m", a[0]},  {"left_pan_rad", a[1]},  {"left_tilt_rad", a[2]},
                         {"right_baseline_m", a[3]}, {"right_pan_rad", a[4]}, {"right_tilt_rad", a[5]}};
+    j["placement"] = fovea::PlacementName(r.placement);
     j["servo"] = {{"iterations", r.servo_iterations},
                   {"residual_px", r.servo_residual_px},
                   {"converged", r.servo_converged}};

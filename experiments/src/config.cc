@@ -120,6 +120,7 @@ std::vector<ConfigParam> ConfigParams(RunConfig* c) {
       {"idr.max_stages", "baseline stage budget", &f.idr.max_stages, 1, 20},
       {"idr.patch_size_px", "IDR patch size, pixels", &f.idr.patch_size_px, 4, 128},
       {"foveal.baseline_m", "vergent baseline, metres", &f.fixation.baseline_m, 0.001, 0.6},
+      {"foveal.choose_placement", "beyond the paper: place the carriages per fixation (symmetric, right or left carriage innermost) so that no mapped surface hides the point from either camera (false: symmetric about the rail centre)", &f.fixation.choose_placement},
       {"foveal.horizontal_disparity_limit_px", "the fovea's horizontal disparity limit (sets Z_T), pixels", &f.fixation.foveal.tessellation.horizontal_disparity_limit_px, 2, 256},
       {"foveal.max_levels", "resolution levels of the tessellation", &f.fixation.foveal.tessellation.max_levels, 1, 6},
       {"foveal.fovea_patch_px", "patch size at full resolution, pixels", &f.fixation.foveal.fovea_patch_px, 4, 64},

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 
+#include "fovea/geometry.h"
 #include "stats.h"
 
 namespace experiments {
@@ -37,6 +38,24 @@ struct Accumulator {
   }
 };
 
+// Whether the right camera's optical centre, its carriage at one of
+// `carriages` and its head turned to p_W, has p_W in sight.
+bool RightCameraSees(const rig::RigGeometry& geometry, const std::vector<double>& carriages,
+                     const sim::GroundTruth& truth, const Eigen::Vector3d& p_W) {
+  // p_W lies on a surface: the ray reaches that surface within this share.
+  constexpr double kOnSurfaceShare = 0.005;
+  for (const double s : carriages) {
+    const Eigen::Vector3d v = p_W - geometry.WorldFromHead(rig::Side::kRight, {s, 0, 0}).translation();
+    const rig::CameraStage stage{s, std::atan2(-v.x(), v.y()), std::atan2(v.z(), std::hypot(v.x(), v.y()))};
+    const Eigen::Vector3d c = geometry.WorldFromCamera(rig::Side::kRight, stage).translation();
+    const Eigen::Vector3d d = p_W - c;
+    const double distance = d.norm();
+    const auto hit = truth.CastRay(c, d / distance);
+    if (!hit || hit->distance_m >= (1 - kOnSurfaceShare) * distance) return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 ReferenceView MakeReferenceView(rig::Rig& rig, const sim::GroundTruth& truth) {
@@ -46,6 +65,55 @@ ReferenceView MakeReferenceView(rig::Rig& rig, const sim::GroundTruth& truth) {
   ref.depth_m = truth.RayCastDepth(ref.view.world_T_camera, ref.view.intrinsics, &ref.geom_ids);
   ref.textured = truth.TexturedMask(ref.geom_ids);
   ref.textured_pixels = cv::countNonZero(ref.textured);
+
+  const rig::AxisLimit& travel = rig.Limits()[rig::Axis::kRightBaseline];
+  std::vector<double> carriages;
+  for (int i = 0; i < kStereoPositions; ++i)
+    carriages.push_back(travel.min + (travel.max - travel.min) * i / (kStereoPositions - 1));
+  const Eigen::Vector3d axis = ref.view.world_T_camera.linear().col(2);
+  const rig::RigGeometry& geometry = rig.Geometry();
+  // Ray casts cost tens of microseconds each against a mesh: first the
+  // depth buffer of each carriage position's right camera (60 degrees wide,
+  // the head turned to the reference view's centre at its mean depth)
+  // accepts the points it shows within 1% of their depth; exact ray casts
+  // decide the rest.
+  constexpr double kDepthShare = 0.01;
+  const double mean_depth = cv::mean(ref.depth_m, ref.textured)[0];
+  const Eigen::Vector3d centre_W = ref.view.world_T_camera * Eigen::Vector3d(0, 0, mean_depth > 0 ? mean_depth : 1);
+  const rig::CameraIntrinsics wide =
+      rig::CameraIntrinsics::FromHorizontalFov(ref.view.intrinsics.width_px, ref.view.intrinsics.height_px, M_PI / 3);
+  struct Seen {
+    Eigen::Isometry3d camera_T_world;
+    cv::Mat depth_m;
+  };
+  std::vector<Seen> renders;
+  for (const double s : carriages) {
+    const Eigen::Vector3d v = centre_W - geometry.WorldFromHead(rig::Side::kRight, {s, 0, 0}).translation();
+    const rig::CameraStage stage{s, std::atan2(-v.x(), v.y()), std::atan2(v.z(), std::hypot(v.x(), v.y()))};
+    const Eigen::Isometry3d world_T_camera = geometry.WorldFromCamera(rig::Side::kRight, stage);
+    renders.push_back({world_T_camera.inverse(), truth.Render(world_T_camera, wide).depth_m});
+  }
+  auto rendered = [&](const Eigen::Vector3d& p_W) {
+    for (const Seen& seen : renders) {
+      const Eigen::Vector3d q = seen.camera_T_world * p_W;
+      if (q.z() <= 0) continue;
+      const int u = static_cast<int>(std::lround(wide.fx_px * q.x() / q.z() + wide.cx_px));
+      const int v = static_cast<int>(std::lround(wide.fy_px * q.y() / q.z() + wide.cy_px));
+      if (u < 0 || v < 0 || u >= seen.depth_m.cols || v >= seen.depth_m.rows) continue;
+      if (seen.depth_m.at<float>(v, u) >= (1 - kDepthShare) * q.z()) return true;
+    }
+    return false;
+  };
+  ref.stereo_visible = cv::Mat::zeros(ref.textured.size(), CV_8U);
+  for (int y = 0; y < ref.textured.rows; ++y)
+    for (int x = 0; x < ref.textured.cols; ++x) {
+      const float z = ref.depth_m.at<float>(y, x);
+      if (!ref.textured.at<uchar>(y, x) || z <= 0) continue;
+      const fovea::Ray ray = fovea::PixelRay(ref.view.world_T_camera, ref.view.intrinsics, {x, y});
+      const Eigen::Vector3d p = ray.origin_W + ray.direction_W * (z / ray.direction_W.dot(axis));
+      if (rendered(p) || RightCameraSees(geometry, carriages, truth, p)) ref.stereo_visible.at<uchar>(y, x) = 255;
+    }
+  ref.stereo_visible_pixels = cv::countNonZero(ref.stereo_visible);
   return ref;
 }
 
@@ -58,19 +126,22 @@ MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref, const si
   Accumulator all;
   std::array<Accumulator, 3> level;
   struct PerSurface {
-    long pixels = 0, mapped = 0, foveal = 0;
+    long pixels = 0, mapped = 0, foveal = 0, stereo_visible = 0;
     Accumulator errors;
   };
   std::map<int, PerSurface> surfaces;
-  long mapped = 0, foveal = 0;
+  long mapped = 0, foveal = 0, mapped_stereo_visible = 0;
   for (int y = 0; y < depth.rows; ++y)
     for (int x = 0; x < depth.cols; ++x) {
       if (!ref.textured.at<uchar>(y, x)) continue;
       const double zt = ref.depth_m.at<float>(y, x);
       PerSurface& ps = surfaces[ref.geom_ids.at<int>(y, x)];
       ++ps.pixels;
+      const bool paired = ref.stereo_visible.at<uchar>(y, x);
+      ps.stereo_visible += paired;
       const int id = ids.at<int>(y, x);
       if (id < 0 || zt <= 0) continue;
+      mapped_stereo_visible += paired;
       const double z = depth.at<float>(y, x);
       const int lv = static_cast<int>(map[id].level);
       ++mapped;
@@ -84,6 +155,9 @@ MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref, const si
   const long total = ref.textured_pixels;
   s.coverage = total ? double(mapped) / total : 0;
   s.foveal_coverage = total ? double(foveal) / total : 0;
+  s.stereo_visible_share = total ? double(ref.stereo_visible_pixels) / total : 0;
+  s.stereo_visible_coverage =
+      ref.stereo_visible_pixels ? double(mapped_stereo_visible) / ref.stereo_visible_pixels : 0;
   s.overall = all.Figures(total);
   for (int i = 0; i < 3; ++i) s.by_level[i] = level[i].Figures(total);
   for (const auto& [geom, ps] : surfaces) {
@@ -92,6 +166,7 @@ MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref, const si
     sf.pixels = ps.pixels;
     sf.coverage = double(ps.mapped) / ps.pixels;
     sf.foveal_coverage = double(ps.foveal) / ps.pixels;
+    sf.stereo_visible_share = double(ps.stereo_visible) / ps.pixels;
     const ErrorFigures e = ps.errors.Figures(ps.pixels);
     sf.median_abs_error_m = e.median_abs_error_m;
     sf.median_rel_error = e.median_rel_error;
@@ -135,6 +210,8 @@ nlohmann::json ScoreJson(const MapScore& s) {
   nlohmann::json j;
   j["coverage"] = s.coverage;
   j["foveal_coverage"] = s.foveal_coverage;
+  j["stereo_visible_share"] = s.stereo_visible_share;
+  j["stereo_visible_coverage"] = s.stereo_visible_coverage;
   j["median_abs_error_m"] = s.overall.median_abs_error_m;
   j["median_rel_error"] = s.overall.median_rel_error;
   j["rmse_m"] = s.overall.rmse_m;
@@ -147,6 +224,7 @@ nlohmann::json ScoreJson(const MapScore& s) {
     j["by_surface"][sf.name] = {{"pixels", sf.pixels},
                                 {"coverage", sf.coverage},
                                 {"foveal_coverage", sf.foveal_coverage},
+                                {"stereo_visible_share", sf.stereo_visible_share},
                                 {"median_abs_error_m", sf.median_abs_error_m},
                                 {"median_rel_error", sf.median_rel_error},
                                 {"median_error_steps", sf.median_error_steps},

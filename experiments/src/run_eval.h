@@ -20,7 +20,19 @@ struct ReferenceView {
   cv::Mat geom_ids;       ///< surface per pixel (CV_32S, -1 = nothing)
   cv::Mat textured;       ///< CV_8U, 255 where a textured surface is visible
   long textured_pixels = 0;
+  /// CV_8U, 255 at the textured pixels whose true point the right camera's
+  /// optical centre has in sight from some carriage position (kStereoPositions
+  /// over its travel, the head turned to the point): the most that any
+  /// stereo pair of the rig can triangulate. Past a nearer surface's left
+  /// edge lies a strip no right camera sees (it sits right of the rail
+  /// centre, the home pose's left camera left of it).
+  cv::Mat stereo_visible;
+  long stereo_visible_pixels = 0;
 };
+
+/// Right carriage positions, evenly spread over its travel, tried by
+/// ReferenceView::stereo_visible.
+constexpr int kStereoPositions = 8;
 
 /// Moves the rig home and captures the left camera there.
 ReferenceView MakeReferenceView(rig::Rig& rig, const sim::GroundTruth& truth);
@@ -38,12 +50,15 @@ struct SurfaceFigures {
   std::string name;
   long pixels = 0;                 ///< visible textured pixels of the surface
   double coverage = 0, foveal_coverage = 0;
+  double stereo_visible_share = 0;  ///< of its pixels, those in ReferenceView::stereo_visible
   double median_abs_error_m = 0, median_rel_error = 0, median_error_steps = 0, rmse_m = 0;  ///< 0 when unmapped
 };
 
 struct MapScore {
   double coverage = 0;             ///< share of visible textured pixels with an estimate
   double foveal_coverage = 0;      ///< ... with a foveal estimate
+  double stereo_visible_share = 0;     ///< of the visible textured pixels, those in ReferenceView::stereo_visible
+  double stereo_visible_coverage = 0;  ///< share of those with an estimate
   ErrorFigures overall;
   std::array<ErrorFigures, 3> by_level;  ///< by PatchLevel of the patch seen
   std::vector<SurfaceFigures> surfaces;

@@ -141,6 +141,7 @@ FoveaRun RunFovea(rig::Rig& rig, const StereoMatcher& matcher, const FoveaOption
     rec.servo_iterations = r.servo.iterations;
     rec.servo_residual_px = r.servo.residual_px;
     rec.servo_converged = r.servo.converged;
+    rec.placement = r.placement;
     rec.tessellation = r.foveal.tessellation;
     rec.tessellation.vertical_disparity_px.release();
     rec.tessellation.mask.release();
@@ -157,9 +158,9 @@ FoveaRun RunFovea(rig::Rig& rig, const StereoMatcher& matcher, const FoveaOption
     rec.foveal_share = FovealShare(run.map, idr_view);
     has_fixation = true;
     fixated.push_back(rec.fixation_W);
-    // A hole's guessed point stays a hole where the fixation found another
-    // depth along its ray and mapped nothing there: suppress it as well.
-    if (rec.selection.in_hole) fixated.push_back(rec.target_W);
+    // The point aimed at stays unmapped where the servo settled elsewhere (a
+    // hole's guessed depth, a false match): suppress it as well.
+    if ((rec.target_W - rec.fixation_W).norm() > options.criteria.revisit_radius_m) fixated.push_back(rec.target_W);
     current = rec.tessellation;
     run.compute_time_s += rec.time.ComputeS();
     run.records.push_back(rec);

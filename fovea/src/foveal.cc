@@ -194,9 +194,18 @@ FixationResult Fixate(rig::Rig& rig, const PatchMap& map, const Eigen::Vector3d&
   options.Check();
   FixationResult r;
   const auto t0 = Clock::now();
-  r.vergence = Verge(rig.Geometry(), rig.Limits(), rig.Intrinsics(rig::Side::kLeft),
-                     rig.Intrinsics(rig::Side::kRight), rig::StageState::Parallel(options.baseline_m), p_W,
-                     options.vergence);
+  if (options.choose_placement) {
+    const PlacementChoice choice =
+        ChoosePlacement(rig.Geometry(), rig.Limits(), rig.Intrinsics(rig::Side::kLeft),
+                        rig.Intrinsics(rig::Side::kRight), map, p_W, options.baseline_m, options.vergence,
+                        guessed_depths);
+    r.placement = choice.placement;
+    r.vergence = choice.vergence;
+  } else {
+    r.vergence = Verge(rig.Geometry(), rig.Limits(), rig.Intrinsics(rig::Side::kLeft),
+                       rig.Intrinsics(rig::Side::kRight), rig::StageState::Parallel(options.baseline_m), p_W,
+                       options.vergence);
+  }
   if (!r.vergence.ok) {
     r.why = r.vergence.why;
     return r;

@@ -76,6 +76,7 @@ struct FixationRecord {
   Eigen::Vector3d target_W = Eigen::Vector3d::Zero();
   Eigen::Vector3d fixation_W = Eigen::Vector3d::Zero();
   rig::StageState state;
+  Placement placement = Placement::kSymmetric;  ///< of the carriages
   int servo_iterations = 0;
   double servo_residual_px = 0;
   bool servo_converged = false;

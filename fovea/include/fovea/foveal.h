@@ -10,6 +10,7 @@
 
 #include "fovea/matcher.h"
 #include "fovea/patch.h"
+#include "fovea/placement.h"
 #include "fovea/servo.h"
 #include "fovea/tessellation.h"
 #include "fovea/vergence.h"
@@ -68,10 +69,14 @@ struct FixationOptions {
   VergenceOptions vergence;
   ServoOptions servo;
   FovealOptions foveal;
-  /// Vergent baseline, symmetric about the rail centre. A narrow one keeps
-  /// the vergence angle small: a larger fovea and Z_T, and a thinner strip
-  /// of surface hidden from the right camera beside a nearer surface's edge.
+  /// Vergent baseline. A narrow one keeps the vergence angle small: a
+  /// larger fovea and Z_T, and a thinner strip of surface hidden from one
+  /// camera beside a nearer surface's edge.
   double baseline_m = 0.06;
+  /// Beyond the paper: place the carriages per fixation (see
+  /// ChoosePlacement) so that no mapped surface hides the point from either
+  /// camera; false: always symmetric about the rail centre.
+  bool choose_placement = true;
   /// Nothing in the scene lies nearer (planar depth in the left camera): a
   /// servo that settles nearer took a false match (a repeated texture's
   /// copy) and the point is refused before any matching (0: no check).
@@ -81,6 +86,7 @@ struct FixationOptions {
 
 struct FixationResult {
   bool ok = false;
+  Placement placement = Placement::kSymmetric;
   std::string why;                   ///< when not ok: why the point could not be fixated
   VergenceSolution vergence;
   ServoResult servo;

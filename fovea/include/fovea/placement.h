@@ -1,0 +1,56 @@
+// Where the carriages sit for a fixation (beyond the paper): each camera
+// sees its own side of a nearer surface's edge, so the placement decides
+// which strips past the edges both cameras see.
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+
+#include "fovea/patch.h"
+#include "fovea/servo.h"
+#include "fovea/vergence.h"
+#include "rig/kinematics.h"
+#include "rig/types.h"
+
+namespace fovea {
+
+/// Where the two carriages sit for a vergent baseline b.
+enum class Placement {
+  kSymmetric,    ///< +-b/2 about the rail centre
+  kRightInner,   ///< right carriage innermost, the left one b to its left
+  kLeftInner,    ///< left carriage innermost (where IDR's left camera sits), the right one b to its right
+};
+const char* PlacementName(Placement placement);
+
+/// Carriage positions (pan and tilt zero) of `placement` for baseline_m.
+rig::StageState PlaceCarriages(const rig::RigLimits& limits, double baseline_m, Placement placement);
+
+/// A placement and the vergence on p_W from it.
+struct PlacementChoice {
+  Placement placement = Placement::kSymmetric;
+  VergenceSolution vergence;
+  int occluded = 0;  ///< sample points the map hides from either camera
+};
+
+/// Beyond the paper. Each camera sees its own side of a nearer surface's
+/// edge: past a near surface's left edge lies a strip the left camera sees
+/// and the right one does not (and the reverse past a right edge), as wide as
+/// the carriages are apart. The views the map is built for (IDR's, the home
+/// pose's) have their left camera left of the rail centre, so the right
+/// carriage innermost is tried first: it puts the right camera as near them
+/// as the rail allows and leaves the thinnest strips past left edges (which
+/// IDR's pair, its right camera moving right, cannot see either). Then
+/// symmetric, then left innermost. For each, this verges on p_W and
+/// raytraces the map from both optical centres to sample points: p_W, and
+/// when its depth is a guess (`guessed_depths`, a hole), the points behind it
+/// on the left optical axis up to 4 times its depth. A sample is hidden from
+/// a camera when the map has a patch more than 3% nearer along the ray.
+/// Returns the first placement with the fewest hidden samples (at once when
+/// one hides none), or the first whose vergence failed if none can fixate
+/// p_W. Cost: 3 vergences and up to 42 ray casts, each O(log patches).
+PlacementChoice ChoosePlacement(const rig::RigGeometry& geometry, const rig::RigLimits& limits,
+                                const rig::CameraIntrinsics& left, const rig::CameraIntrinsics& right,
+                                const PatchMap& map, const Eigen::Vector3d& p_W, double baseline_m,
+                                const VergenceOptions& vergence, const std::optional<DepthRange>& guessed_depths);
+
+}  // namespace fovea

@@ -1,0 +1,109 @@
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "fovea/placement.h"
+
+namespace {
+rig::RigGeometry Geometry() {
+  rig::RigGeometry g;
+  g.left.optical_centre_H = g.right.optical_centre_H = {0.0, 0.03, 0.01};
+  return g;
+}
+rig::RigLimits Limits() {
+  rig::RigLimits l;
+  const double ang = 6400 * 180 / M_PI;
+  l[rig::Axis::kLeftBaseline] = {-0.3, -0.0005, 400e3};
+  l[rig::Axis::kRightBaseline] = {0.0005, 0.3, 400e3};
+  for (auto a : {rig::Axis::kLeftPan, rig::Axis::kRightPan}) l[a] = {-M_PI / 3, M_PI / 3, ang};
+  for (auto a : {rig::Axis::kLeftTilt, rig::Axis::kRightTilt}) l[a] = {-M_PI / 6, M_PI / 6, ang};
+  return l;
+}
+const rig::CameraIntrinsics kCamera = rig::CameraIntrinsics::FromHorizontalFov(640, 480, 30 * M_PI / 180);
+constexpr double kBaseline = 0.06;
+
+// A square facing the rig (normal along world y), `half` metres to each side of centre_W.
+fovea::Patch Square(const Eigen::Vector3d& centre_W, double half) {
+  fovea::Patch p;
+  p.corners_W = {centre_W + Eigen::Vector3d(-half, 0, -half), centre_W + Eigen::Vector3d(half, 0, -half),
+                 centre_W + Eigen::Vector3d(half, 0, half), centre_W + Eigen::Vector3d(-half, 0, half)};
+  return p;
+}
+
+fovea::PlacementChoice Choose(const fovea::PatchMap& map, const Eigen::Vector3d& p_W,
+                              const std::optional<fovea::DepthRange>& guessed = std::nullopt) {
+  return fovea::ChoosePlacement(Geometry(), Limits(), kCamera, kCamera, map, p_W, kBaseline, {}, guessed);
+}
+
+Eigen::Vector3d OpticalCentre(const fovea::VergenceSolution& v, rig::Side side) {
+  return Geometry().WorldFromCamera(side, v.state[side]).translation();
+}
+}  // namespace
+
+TEST_CASE("carriage placements keep the baseline and put the named carriage innermost", "[fovea][placement]") {
+  const rig::RigLimits l = Limits();
+  using fovea::Placement;
+  const rig::StageState sym = fovea::PlaceCarriages(l, kBaseline, Placement::kSymmetric);
+  CHECK(sym.left.baseline_m == Approx(-0.03));
+  CHECK(sym.right.baseline_m == Approx(0.03));
+  const rig::StageState ri = fovea::PlaceCarriages(l, kBaseline, Placement::kRightInner);
+  CHECK(ri.right.baseline_m == Approx(0.0005));
+  CHECK(ri.left.baseline_m == Approx(-0.0595));
+  const rig::StageState li = fovea::PlaceCarriages(l, kBaseline, Placement::kLeftInner);
+  CHECK(li.left.baseline_m == Approx(-0.0005));
+  CHECK(li.right.baseline_m == Approx(0.0595));
+  for (const rig::StageState& s : {sym, ri, li}) CHECK(s.BaselineM() == Approx(kBaseline));
+  CHECK(std::string(fovea::PlacementName(Placement::kRightInner)) == "right_inner");
+}
+
+TEST_CASE("placement: the right carriage innermost unless the map hides the point from it", "[fovea][placement]") {
+  const Eigen::Vector3d p(0.0, 1.2, 0.0);
+  fovea::PatchMap map;
+  map.Add(Square(p, 0.2));  // the surface the point lies on
+
+  fovea::PlacementChoice free = Choose(map, p);
+  REQUIRE(free.vergence.ok);
+  CHECK(free.placement == fovea::Placement::kRightInner);
+  CHECK(free.occluded == 0);
+  CHECK(free.vergence.state.right.baseline_m == Approx(0.0005).margin(1e-5));
+
+  // A 1 cm square halfway along the right camera's line of sight from there:
+  // the symmetric placement's cameras look past it (1.5 cm to either side).
+  const Eigen::Vector3d right_c = OpticalCentre(free.vergence, rig::Side::kRight);
+  map.Add(Square(0.5 * (right_c + p), 0.005));
+  const fovea::PlacementChoice moved = Choose(map, p);
+  REQUIRE(moved.vergence.ok);
+  CHECK(moved.placement == fovea::Placement::kSymmetric);
+  CHECK(moved.occluded == 0);
+  CHECK(moved.vergence.state.BaselineM() == Approx(kBaseline).margin(1e-5));
+
+  // A wall in front hides the point from every placement's both cameras:
+  // the first placement stays, with both cameras counted.
+  map.Add(Square({0.0, 0.8, 0.0}, 0.3));
+  const fovea::PlacementChoice walled = Choose(map, p);
+  REQUIRE(walled.vergence.ok);
+  CHECK(walled.placement == fovea::Placement::kRightInner);
+  CHECK(walled.occluded == 2);
+}
+
+TEST_CASE("placement: a guessed depth also weighs the points behind it", "[fovea][placement]") {
+  // A hole's point guessed at 0.6 m with a mapped wall at 1.0 m behind it:
+  // the samples past the wall are hidden from both cameras.
+  const Eigen::Vector3d p(0.02, 0.6, 0.0);
+  fovea::PatchMap map;
+  map.Add(Square({0.0, 1.0, 0.0}, 1.0));
+  const fovea::PlacementChoice known = Choose(map, p);
+  REQUIRE(known.vergence.ok);
+  CHECK(known.occluded == 0);
+  const fovea::PlacementChoice guessed = Choose(map, p, fovea::DepthRange{0.4, 1e5});
+  REQUIRE(guessed.vergence.ok);
+  CHECK(guessed.occluded > 0);
+  CHECK(guessed.occluded % 2 == 0);  // both cameras, every time
+  // Points beyond the guessed range are not sampled.
+  CHECK(Choose(map, p, fovea::DepthRange{0.4, 0.9}).occluded == 0);
+}
+
+TEST_CASE("placement: a point no placement can fixate is reported, with why", "[fovea][placement]") {
+  const fovea::PlacementChoice behind = Choose({}, {0.0, -1.0, 0.0});
+  CHECK_FALSE(behind.vergence.ok);
+  CHECK_FALSE(behind.vergence.why.empty());
+}
