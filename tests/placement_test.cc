@@ -2,22 +2,9 @@
 #include <cmath>
 
 #include "fovea/placement.h"
+#include "test_rig.h"
 
 namespace {
-rig::RigGeometry Geometry() {
-  rig::RigGeometry g;
-  g.left.optical_centre_H = g.right.optical_centre_H = {0.0, 0.03, 0.01};
-  return g;
-}
-rig::RigLimits Limits() {
-  rig::RigLimits l;
-  const double ang = 6400 * 180 / M_PI;
-  l[rig::Axis::kLeftBaseline] = {-0.3, -0.0005, 400e3};
-  l[rig::Axis::kRightBaseline] = {0.0005, 0.3, 400e3};
-  for (auto a : {rig::Axis::kLeftPan, rig::Axis::kRightPan}) l[a] = {-M_PI / 3, M_PI / 3, ang};
-  for (auto a : {rig::Axis::kLeftTilt, rig::Axis::kRightTilt}) l[a] = {-M_PI / 6, M_PI / 6, ang};
-  return l;
-}
 const rig::CameraIntrinsics kCamera = rig::CameraIntrinsics::FromHorizontalFov(640, 480, 30 * M_PI / 180);
 constexpr double kBaseline = 0.06;
 
@@ -31,16 +18,16 @@ fovea::Patch Square(const Eigen::Vector3d& centre_W, double half) {
 
 fovea::PlacementChoice Choose(const fovea::PatchMap& map, const Eigen::Vector3d& p_W,
                               const std::optional<fovea::DepthRange>& guessed = std::nullopt) {
-  return fovea::ChoosePlacement(Geometry(), Limits(), kCamera, kCamera, map, p_W, kBaseline, {}, guessed);
+  return fovea::ChoosePlacement(TestGeometry(), TestLimits(), kCamera, kCamera, map, p_W, kBaseline, {}, guessed);
 }
 
 Eigen::Vector3d OpticalCentre(const fovea::VergenceSolution& v, rig::Side side) {
-  return Geometry().WorldFromCamera(side, v.state[side]).translation();
+  return TestGeometry().WorldFromCamera(side, v.state[side]).translation();
 }
 }  // namespace
 
 TEST_CASE("carriage placements keep the baseline and put the named carriage innermost", "[fovea][placement]") {
-  const rig::RigLimits l = Limits();
+  const rig::RigLimits l = TestLimits();
   using fovea::Placement;
   const rig::StageState sym = fovea::PlaceCarriages(l, kBaseline, Placement::kSymmetric);
   CHECK(sym.left.baseline_m == Approx(-0.03));

@@ -3,32 +3,16 @@
 
 #include "fovea/geometry.h"
 #include "fovea/vergence.h"
-
-namespace {
-rig::RigGeometry Geometry() {
-  rig::RigGeometry g;
-  g.left.optical_centre_H = g.right.optical_centre_H = {0.0, 0.03, 0.01};  // offset from the axes
-  return g;
-}
-rig::RigLimits Limits() {
-  rig::RigLimits l;
-  const double ang = 6400 * 180 / M_PI;
-  l[rig::Axis::kLeftBaseline] = {-0.3, -0.0005, 400e3};
-  l[rig::Axis::kRightBaseline] = {0.0005, 0.3, 400e3};
-  for (auto a : {rig::Axis::kLeftPan, rig::Axis::kRightPan}) l[a] = {-M_PI / 3, M_PI / 3, ang};
-  for (auto a : {rig::Axis::kLeftTilt, rig::Axis::kRightTilt}) l[a] = {-M_PI / 6, M_PI / 6, ang};
-  return l;
-}
-}  // namespace
+#include "test_rig.h"
 
 TEST_CASE("vergence puts the point on both optical axes despite the centre offset", "[fovea][vergence]") {
-  const auto g = Geometry();
+  const auto g = TestGeometry();
   const auto k = rig::CameraIntrinsics::FromHorizontalFov(640, 480, 30 * M_PI / 180);
   const rig::StageState base = rig::StageState::Parallel(0.12);
   for (const Eigen::Vector3d& p : {Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0.2, 0.6, -0.1),
                                    Eigen::Vector3d(-0.3, 1.4, 0.2), Eigen::Vector3d(0.05, 0.45, 0.05)}) {
     INFO(p.transpose());
-    const auto sol = fovea::Verge(g, Limits(), k, k, base, p);
+    const auto sol = fovea::Verge(g, TestLimits(), k, k, base, p);
     REQUIRE(sol.ok);
     for (rig::Side side : {rig::Side::kLeft, rig::Side::kRight}) {
       const auto uv = fovea::ProjectWorldPoint(g.WorldFromCamera(side, sol.state[side]), k, p);
@@ -48,15 +32,15 @@ TEST_CASE("vergence puts the point on both optical axes despite the centre offse
 }
 
 TEST_CASE("points that cannot be fixated are reported, not clamped", "[fovea][vergence]") {
-  const auto g = Geometry();
+  const auto g = TestGeometry();
   const auto k = rig::CameraIntrinsics::FromHorizontalFov(640, 480, 30 * M_PI / 180);
   const rig::StageState base = rig::StageState::Parallel(0.12);
-  const auto beside = fovea::Verge(g, Limits(), k, k, base, Eigen::Vector3d(2.0, 0.5, 0));  // 76 deg pan
+  const auto beside = fovea::Verge(g, TestLimits(), k, k, base, Eigen::Vector3d(2.0, 0.5, 0));  // 76 deg pan
   CHECK_FALSE(beside.ok);
   CHECK(beside.why.find("limits") != std::string::npos);
-  const auto above = fovea::Verge(g, Limits(), k, k, base, Eigen::Vector3d(0, 0.5, 0.5));  // 45 deg tilt
+  const auto above = fovea::Verge(g, TestLimits(), k, k, base, Eigen::Vector3d(0, 0.5, 0.5));  // 45 deg tilt
   CHECK_FALSE(above.ok);
-  const auto near = fovea::Verge(g, Limits(), k, k, base, Eigen::Vector3d(0, 0.1, 0));
+  const auto near = fovea::Verge(g, TestLimits(), k, k, base, Eigen::Vector3d(0, 0.1, 0));
   CHECK_FALSE(near.ok);
   CHECK(near.why.find("nearer") != std::string::npos);
 }
