@@ -8,6 +8,17 @@ namespace {
 const rig::CameraIntrinsics kCamera = rig::CameraIntrinsics::FromHorizontalFov(640, 480, 30 * M_PI / 180);
 constexpr double kBaseline = 0.06;
 
+// The simulator's default rig, home pose 0.10 m wide.
+fovea::PlacementRig TestRig(bool left_pair = true) {
+  fovea::PlacementRig r;
+  r.geometry = TestGeometry();
+  r.limits = TestLimits();
+  r.left = r.right = kCamera;
+  r.home_left_m = -0.05;
+  r.left_pair = left_pair;
+  return r;
+}
+
 // A square facing the rig (normal along world y), `half` metres to each side of centre_W.
 fovea::Patch Square(const Eigen::Vector3d& centre_W, double half) {
   fovea::Patch p;
@@ -17,17 +28,18 @@ fovea::Patch Square(const Eigen::Vector3d& centre_W, double half) {
 }
 
 fovea::PlacementChoice Choose(const fovea::PatchMap& map, const Eigen::Vector3d& p_W,
-                              const std::optional<fovea::DepthRange>& guessed = std::nullopt) {
-  return fovea::ChoosePlacement(TestGeometry(), TestLimits(), kCamera, kCamera, map, p_W, kBaseline, {}, guessed);
+                              const std::optional<fovea::DepthRange>& guessed = std::nullopt, bool left_pair = true) {
+  return fovea::ChoosePlacement(TestRig(left_pair), map, p_W, kBaseline, {}, guessed);
 }
 
-Eigen::Vector3d OpticalCentre(const fovea::VergenceSolution& v, rig::Side side) {
-  return TestGeometry().WorldFromCamera(side, v.state[side]).translation();
+// The optical centre of one camera of the pair the choice uses.
+Eigen::Vector3d OpticalCentre(const fovea::PlacementChoice& c, rig::Side side) {
+  return TestRig().For(c.placement).geometry.WorldFromCamera(side, c.vergence.state[side]).translation();
 }
 }  // namespace
 
 TEST_CASE("carriage placements keep the baseline and put the named carriage innermost", "[fovea][placement]") {
-  const rig::RigLimits l = TestLimits();
+  const fovea::PlacementRig l = TestRig();
   using fovea::Placement;
   const rig::StageState sym = fovea::PlaceCarriages(l, kBaseline, Placement::kSymmetric);
   CHECK(sym.left.baseline_m == Approx(-0.03));
@@ -38,7 +50,13 @@ TEST_CASE("carriage placements keep the baseline and put the named carriage inne
   const rig::StageState li = fovea::PlaceCarriages(l, kBaseline, Placement::kLeftInner);
   CHECK(li.left.baseline_m == Approx(-0.0005));
   CHECK(li.right.baseline_m == Approx(0.0595));
-  for (const rig::StageState& s : {sym, ri, li}) CHECK(s.BaselineM() == Approx(kBaseline));
+  // The left camera pair: its right stage at the home pose's left carriage.
+  const rig::StageState lp = fovea::PlaceCarriages(l, kBaseline, Placement::kLeftPair);
+  CHECK(lp.right.baseline_m == Approx(-0.05));
+  CHECK(lp.left.baseline_m == Approx(-0.11));
+  CHECK(l.For(Placement::kLeftPair).limits.Violation(lp).empty());
+  CHECK_FALSE(l.limits.Violation(lp).empty());  // no place for the real right camera
+  for (const rig::StageState& s : {sym, ri, li, lp}) CHECK(s.BaselineM() == Approx(kBaseline));
   CHECK(std::string(fovea::PlacementName(Placement::kRightInner)) == "right_inner");
 }
 
@@ -55,7 +73,7 @@ TEST_CASE("placement: the right carriage innermost unless the map hides the poin
 
   // A 1 cm square halfway along the right camera's line of sight from there:
   // the symmetric placement's cameras look past it (1.5 cm to either side).
-  const Eigen::Vector3d right_c = OpticalCentre(free.vergence, rig::Side::kRight);
+  const Eigen::Vector3d right_c = OpticalCentre(free, rig::Side::kRight);
   map.Add(Square(0.5 * (right_c + p), 0.005));
   const fovea::PlacementChoice moved = Choose(map, p);
   REQUIRE(moved.vergence.ok);
@@ -63,8 +81,9 @@ TEST_CASE("placement: the right carriage innermost unless the map hides the poin
   CHECK(moved.occluded == 0);
   CHECK(moved.vergence.state.BaselineM() == Approx(kBaseline).margin(1e-5));
 
-  // A wall in front hides the point from every placement's both cameras:
-  // the first placement stays, with both cameras counted.
+  // A wall in front hides the point from every placement's both cameras
+  // (the left camera pair's too): the first placement stays, with both
+  // cameras counted.
   map.Add(Square({0.0, 0.8, 0.0}, 0.3));
   const fovea::PlacementChoice walled = Choose(map, p);
   REQUIRE(walled.vergence.ok);
@@ -93,4 +112,32 @@ TEST_CASE("placement: a point no placement can fixate is reported, with why", "[
   const fovea::PlacementChoice behind = Choose({}, {0.0, -1.0, 0.0});
   CHECK_FALSE(behind.vergence.ok);
   CHECK_FALSE(behind.vergence.why.empty());
+}
+
+TEST_CASE("placement: past a near left edge, where no right camera sees, the left camera pairs with itself",
+          "[fovea][placement]") {
+  // A block face at 0.5 m whose left edge is at x = -0.07, and the plane at
+  // 1.2 m: the point just left of the edge (seen from the home pose's left
+  // camera at x = -0.05) is hidden from every right camera position (x >=
+  // 0.0005) by the block.
+  const Eigen::Vector3d p(-0.13, 1.2, 0.0);
+  fovea::PatchMap map;
+  map.Add(Square(p, 0.1));
+  fovea::Patch block;
+  block.corners_W = {Eigen::Vector3d(-0.07, 0.5, -0.1), Eigen::Vector3d(0.2, 0.5, -0.1),
+                     Eigen::Vector3d(0.2, 0.5, 0.1), Eigen::Vector3d(-0.07, 0.5, 0.1)};
+  map.Add(block);
+  const fovea::PlacementChoice without = Choose(map, p, std::nullopt, false);
+  REQUIRE(without.vergence.ok);
+  CHECK(without.occluded >= 1);
+  const fovea::PlacementChoice with = Choose(map, p);
+  REQUIRE(with.vergence.ok);
+  CHECK(with.placement == fovea::Placement::kLeftPair);
+  CHECK(with.occluded == 0);
+  CHECK(with.vergence.state.right.baseline_m == Approx(-0.05).margin(1e-5));
+  // Both of its "cameras" are the left head: on the point's line of sight
+  // from either stage.
+  const Eigen::Vector3d a = OpticalCentre(with, rig::Side::kLeft), b = OpticalCentre(with, rig::Side::kRight);
+  CHECK(a.x() < b.x());
+  CHECK(b.x() < -0.04);
 }

@@ -121,6 +121,7 @@ std::vector<ConfigParam> ConfigParams(RunConfig* c) {
       {"idr.patch_size_px", "IDR patch size, pixels", &f.idr.patch_size_px, 4, 128},
       {"foveal.baseline_m", "vergent baseline, metres", &f.fixation.baseline_m, 0.001, 0.6},
       {"foveal.choose_placement", "beyond the paper: place the carriages per fixation (symmetric, right or left carriage innermost) so that no mapped surface hides the point from either camera (false: symmetric about the rail centre)", &f.fixation.choose_placement},
+      {"foveal.left_pair", "beyond the paper, with foveal.choose_placement: where the map hides a point from every right camera, pair the left camera with itself at two carriage positions (the home pose's and foveal.baseline_m to its left; motion stereo, the scene must hold still)", &f.fixation.left_pair},
       {"foveal.horizontal_disparity_limit_px", "the fovea's horizontal disparity limit (sets Z_T), pixels", &f.fixation.foveal.tessellation.horizontal_disparity_limit_px, 2, 256},
       {"foveal.max_levels", "resolution levels of the tessellation", &f.fixation.foveal.tessellation.max_levels, 1, 6},
       {"foveal.fovea_patch_px", "patch size at full resolution, pixels", &f.fixation.foveal.fovea_patch_px, 4, 64},

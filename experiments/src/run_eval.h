@@ -22,10 +22,11 @@ struct ReferenceView {
   long textured_pixels = 0;
   /// CV_8U, 255 at the textured pixels whose true point the right camera's
   /// optical centre has in sight from some carriage position (kStereoPositions
-  /// over its travel, the head turned to the point): the most that any
-  /// stereo pair of the rig can triangulate. Past a nearer surface's left
-  /// edge lies a strip no right camera sees (it sits right of the rail
-  /// centre, the home pose's left camera left of it).
+  /// over its travel, the head turned to the point): the most that pairs of
+  /// the two cameras can triangulate. Past a nearer surface's left edge lies
+  /// a strip no right camera sees (it sits right of the rail centre, the
+  /// home pose's left camera left of it); only the left camera paired with
+  /// itself (rig::LeftCameraPair) sees there.
   cv::Mat stereo_visible;
   long stereo_visible_pixels = 0;
 };

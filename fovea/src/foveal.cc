@@ -7,6 +7,7 @@
 
 #include "fovea/geometry.h"
 #include "fovea/timing.h"
+#include "rig/left_pair.h"
 
 namespace fovea {
 
@@ -195,10 +196,8 @@ FixationResult Fixate(rig::Rig& rig, const PatchMap& map, const Eigen::Vector3d&
   FixationResult r;
   const auto t0 = Clock::now();
   if (options.choose_placement) {
-    const PlacementChoice choice =
-        ChoosePlacement(rig.Geometry(), rig.Limits(), rig.Intrinsics(rig::Side::kLeft),
-                        rig.Intrinsics(rig::Side::kRight), map, p_W, options.baseline_m, options.vergence,
-                        guessed_depths);
+    const PlacementChoice choice = ChoosePlacement(PlacementRig::Of(rig, options.left_pair), map, p_W,
+                                                   options.baseline_m, options.vergence, guessed_depths);
     r.placement = choice.placement;
     r.vergence = choice.vergence;
   } else {
@@ -213,7 +212,10 @@ FixationResult Fixate(rig::Rig& rig, const PatchMap& map, const Eigen::Vector3d&
   const double verge_s = Since(t0);
   r.verge_time_s = verge_s;
   const auto t_servo = Clock::now();
-  r.servo = Servo(rig, r.vergence.state, options.servo, guessed_depths);
+  std::optional<rig::LeftCameraPair> left_pair;
+  if (r.placement == Placement::kLeftPair) left_pair.emplace(rig);
+  rig::Rig& pair = left_pair ? static_cast<rig::Rig&>(*left_pair) : rig;
+  r.servo = Servo(pair, r.vergence.state, options.servo, guessed_depths);
   r.servo_wall_s = Since(t_servo);
   r.motion_time_s = r.servo.motion_time_s;
   if (guessed_depths && !r.servo.converged) {

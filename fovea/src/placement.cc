@@ -2,6 +2,8 @@
 
 #include <vector>
 
+#include "rig/left_pair.h"
+
 namespace fovea {
 
 const char* PlacementName(Placement placement) {
@@ -9,13 +11,38 @@ const char* PlacementName(Placement placement) {
     case Placement::kSymmetric: return "symmetric";
     case Placement::kRightInner: return "right_inner";
     case Placement::kLeftInner: return "left_inner";
+    case Placement::kLeftPair: return "left_pair";
   }
   return "?";
 }
 
-rig::StageState PlaceCarriages(const rig::RigLimits& limits, double baseline_m, Placement placement) {
+PlacementRig PlacementRig::Of(const rig::Rig& rig, bool left_pair) {
+  PlacementRig r;
+  r.geometry = rig.Geometry();
+  r.limits = rig.Limits();
+  r.left = rig.Intrinsics(rig::Side::kLeft);
+  r.right = rig.Intrinsics(rig::Side::kRight);
+  r.home_left_m = rig.Home().left.baseline_m;
+  r.left_pair = left_pair;
+  return r;
+}
+
+PlacementRig PlacementRig::For(Placement placement) const {
+  if (placement != Placement::kLeftPair) return *this;
+  PlacementRig r = *this;
+  r.geometry = rig::LeftPairGeometry(geometry);
+  r.limits = rig::LeftPairLimits(limits);
+  r.right = left;
+  return r;
+}
+
+rig::StageState PlaceCarriages(const PlacementRig& rig, double baseline_m, Placement placement) {
+  const rig::RigLimits& limits = rig.limits;
   rig::StageState s = rig::StageState::Parallel(baseline_m);
-  if (placement == Placement::kRightInner) {
+  if (placement == Placement::kLeftPair) {
+    s.right.baseline_m = rig.home_left_m;
+    s.left.baseline_m = rig.home_left_m - baseline_m;
+  } else if (placement == Placement::kRightInner) {
     s.right.baseline_m = limits[rig::Axis::kRightBaseline].min;
     s.left.baseline_m = s.right.baseline_m - baseline_m;
   } else if (placement == Placement::kLeftInner) {
@@ -25,9 +52,8 @@ rig::StageState PlaceCarriages(const rig::RigLimits& limits, double baseline_m, 
   return s;
 }
 
-PlacementChoice ChoosePlacement(const rig::RigGeometry& geometry, const rig::RigLimits& limits,
-                                const rig::CameraIntrinsics& left, const rig::CameraIntrinsics& right,
-                                const PatchMap& map, const Eigen::Vector3d& p_W, double baseline_m,
+PlacementChoice ChoosePlacement(const PlacementRig& rig, const PatchMap& map, const Eigen::Vector3d& p_W,
+                                double baseline_m,
                                 const VergenceOptions& vergence, const std::optional<DepthRange>& guessed_depths) {
   // A sample is hidden when the map has a patch this share nearer along the ray.
   constexpr double kNearerShare = 0.03;
@@ -40,10 +66,15 @@ PlacementChoice ChoosePlacement(const rig::RigGeometry& geometry, const rig::Rig
     return hit && hit->distance_m < (1 - kNearerShare) * distance;
   };
   std::optional<PlacementChoice> best, failed;
-  for (Placement placement : {Placement::kRightInner, Placement::kSymmetric, Placement::kLeftInner}) {
+  for (Placement placement :
+       {Placement::kRightInner, Placement::kSymmetric, Placement::kLeftInner, Placement::kLeftPair}) {
+    if (placement == Placement::kLeftPair && !rig.left_pair) continue;
+    const PlacementRig pair = rig.For(placement);
+    const rig::RigGeometry& geometry = pair.geometry;
     PlacementChoice c;
     c.placement = placement;
-    c.vergence = Verge(geometry, limits, left, right, PlaceCarriages(limits, baseline_m, placement), p_W, vergence);
+    c.vergence = Verge(geometry, pair.limits, pair.left, pair.right, PlaceCarriages(pair, baseline_m, placement), p_W,
+                       vergence);
     if (!c.vergence.ok) {
       if (!failed) failed = c;
       continue;

@@ -77,6 +77,9 @@ struct FixationOptions {
   /// ChoosePlacement) so that no mapped surface hides the point from either
   /// camera; false: always symmetric about the rail centre.
   bool choose_placement = true;
+  /// With choose_placement: also consider the left camera alone at two
+  /// positions (Placement::kLeftPair) for points no right camera sees.
+  bool left_pair = true;
   /// Nothing in the scene lies nearer (planar depth in the left camera): a
   /// servo that settles nearer took a false match (a repeated texture's
   /// copy) and the point is refused before any matching (0: no check).

@@ -10,6 +10,7 @@
 #include "fovea/servo.h"
 #include "fovea/vergence.h"
 #include "rig/kinematics.h"
+#include "rig/rig.h"
 #include "rig/types.h"
 
 namespace fovea {
@@ -19,11 +20,30 @@ enum class Placement {
   kSymmetric,    ///< +-b/2 about the rail centre
   kRightInner,   ///< right carriage innermost, the left one b to its left
   kLeftInner,    ///< left carriage innermost (where IDR's left camera sits), the right one b to its right
+  /// The left camera alone at two positions (rig::LeftCameraPair): its
+  /// "right" stage at the home pose's left carriage, its left stage b
+  /// further left. Sees past nearer surfaces' left edges what the home
+  /// pose's left camera sees there and no right camera can.
+  kLeftPair,
 };
 const char* PlacementName(Placement placement);
 
-/// Carriage positions (pan and tilt zero) of `placement` for baseline_m.
-rig::StageState PlaceCarriages(const rig::RigLimits& limits, double baseline_m, Placement placement);
+/// What ChoosePlacement needs of the rig.
+struct PlacementRig {
+  rig::RigGeometry geometry;
+  rig::RigLimits limits;
+  rig::CameraIntrinsics left, right;
+  double home_left_m = 0;  ///< the left carriage at the home pose
+  bool left_pair = true;   ///< also consider Placement::kLeftPair
+  static PlacementRig Of(const rig::Rig& rig, bool left_pair);
+  /// Geometry, limits and right intrinsics of the pair `placement` uses
+  /// (the virtual pair's for kLeftPair).
+  PlacementRig For(Placement placement) const;
+};
+
+/// Carriage positions (pan and tilt zero) of `placement` for baseline_m; for
+/// kLeftPair, the virtual pair's stages.
+rig::StageState PlaceCarriages(const PlacementRig& rig, double baseline_m, Placement placement);
 
 /// A placement and the vergence on p_W from it.
 struct PlacementChoice {
@@ -40,17 +60,18 @@ struct PlacementChoice {
 /// carriage innermost is tried first: it puts the right camera as near them
 /// as the rail allows and leaves the thinnest strips past left edges (which
 /// IDR's pair, its right camera moving right, cannot see either). Then
-/// symmetric, then left innermost. For each, this verges on p_W and
+/// symmetric, then left innermost, then the left camera pair. For each, this verges on p_W and
 /// raytraces the map from both optical centres to sample points: p_W, and
 /// when its depth is a guess (`guessed_depths`, a hole), the points behind it
 /// on the left optical axis up to 4 times its depth. A sample is hidden from
 /// a camera when the map has a patch more than 3% nearer along the ray.
 /// Returns the first placement with the fewest hidden samples (at once when
 /// one hides none), or the first whose vergence failed if none can fixate
-/// p_W. Cost: 3 vergences and up to 42 ray casts, each O(log patches).
-PlacementChoice ChoosePlacement(const rig::RigGeometry& geometry, const rig::RigLimits& limits,
-                                const rig::CameraIntrinsics& left, const rig::CameraIntrinsics& right,
-                                const PatchMap& map, const Eigen::Vector3d& p_W, double baseline_m,
+/// p_W. Last, if `rig.left_pair`, the left camera pair (kLeftPair), which
+/// costs twice the moves. Cost: 4 vergences and up to 56 ray casts, each
+/// O(log patches).
+PlacementChoice ChoosePlacement(const PlacementRig& rig, const PatchMap& map, const Eigen::Vector3d& p_W,
+                                double baseline_m,
                                 const VergenceOptions& vergence, const std::optional<DepthRange>& guessed_depths);
 
 }  // namespace fovea
