@@ -81,9 +81,11 @@ FoveaRun RunFovea(rig::Rig& rig, const StereoMatcher& matcher, const FoveaOption
   std::vector<Eigen::Vector3d> refused, fixated;
   std::vector<double> share_history;
   // Nothing lies nearer than idr.z_min_m: a fixation the servo settles
-  // nearer is refused.
+  // nearer is refused, and where the map is silent the fovea's wider search
+  // starts there.
   FixationOptions fixation_options = options.fixation;
   fixation_options.min_depth_m = options.idr.z_min_m;
+  fixation_options.foveal.silent_near_m = options.silent_check ? options.idr.z_min_m : 0;
   const int max_attempts = options.fixations * options.attempts_per_fixation;
   run.stop_reason = "done: " + std::to_string(options.fixations) + " fixations";
   for (int attempt = 1; run.fixations_done < options.fixations; ++attempt) {

@@ -49,6 +49,11 @@ struct FoveaOptions {
   /// Beyond the paper: pixels the map is silent at are fixation candidates
   /// too, at the depth of the nearest mapped pixel (SelectionContext::Make).
   bool fixate_holes = true;
+  /// Beyond the paper: where the map is silent, the fovea also searches every
+  /// depth from idr.z_min_m (the scene's nearest) to infinity and drops Z_T
+  /// matches that search contradicts (sets FovealOptions::silent_near_m;
+  /// false: the paper's Z_T search only).
+  bool silent_check = true;
   /// Stop early when the map's foveal share of the IDR view grew by less
   /// than `stall_growth` over this many fixations in a row (0 = never).
   int stall_fixations = 0;

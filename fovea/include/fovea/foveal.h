@@ -34,7 +34,8 @@ struct FovealOptions {
   /// are also searched over every depth from this many metres to infinity,
   /// and a band match is dropped where that wider search matched outside the
   /// band with at least `silent_confidence` (a repeated texture's copies
-  /// leave its confidence low: the band's prior stands).
+  /// leave its confidence low: the band's prior stands). RunFovea sets it
+  /// to idr.z_min_m (FoveaOptions::silent_check).
   double silent_near_m = 0.4;
   double silent_confidence = 0.2;
   void Check() const;
