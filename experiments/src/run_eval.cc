@@ -45,9 +45,8 @@ bool RightCameraSees(const rig::RigGeometry& geometry, const std::vector<double>
   // p_W lies on a surface: the ray reaches that surface within this share.
   constexpr double kOnSurfaceShare = 0.005;
   for (const double s : carriages) {
-    const Eigen::Vector3d v = p_W - geometry.WorldFromHead(rig::Side::kRight, {s, 0, 0}).translation();
-    const rig::CameraStage stage{s, std::atan2(-v.x(), v.y()), std::atan2(v.z(), std::hypot(v.x(), v.y()))};
-    const Eigen::Vector3d c = geometry.WorldFromCamera(rig::Side::kRight, stage).translation();
+    const Eigen::Vector3d c =
+        geometry.WorldFromCamera(rig::Side::kRight, geometry.FacingStage(rig::Side::kRight, s, p_W)).translation();
     const Eigen::Vector3d d = p_W - c;
     const double distance = d.norm();
     const auto hit = truth.CastRay(c, d / distance);
@@ -88,9 +87,8 @@ ReferenceView MakeReferenceView(rig::Rig& rig, const sim::GroundTruth& truth) {
   };
   std::vector<Seen> renders;
   for (const double s : carriages) {
-    const Eigen::Vector3d v = centre_W - geometry.WorldFromHead(rig::Side::kRight, {s, 0, 0}).translation();
-    const rig::CameraStage stage{s, std::atan2(-v.x(), v.y()), std::atan2(v.z(), std::hypot(v.x(), v.y()))};
-    const Eigen::Isometry3d world_T_camera = geometry.WorldFromCamera(rig::Side::kRight, stage);
+    const Eigen::Isometry3d world_T_camera =
+        geometry.WorldFromCamera(rig::Side::kRight, geometry.FacingStage(rig::Side::kRight, s, centre_W));
     renders.push_back({world_T_camera.inverse(), truth.Render(world_T_camera, wide).depth_m});
   }
   auto rendered = [&](const Eigen::Vector3d& p_W) {

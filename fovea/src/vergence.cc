@@ -41,9 +41,8 @@ VergenceSolution Verge(const rig::RigGeometry& g, const rig::RigLimits& limits,
                 std::to_string(options.min_distance_m) + " m";
       return sol;
     }
-    // Start: the optical centre on the axes (two atan2 calls).
-    stage.pan_rad = std::atan2(-v.x(), v.y());
-    stage.tilt_rad = std::atan2(v.z(), std::hypot(v.x(), v.y()));
+    // Start: the optical centre on the axes.
+    stage = g.FacingStage(side, stage.baseline_m, p_W);
     // Newton on the normalized projection (x/z, y/z) -> 0.
     double z = 0;
     for (int it = 0; it < options.max_iterations; ++it) {

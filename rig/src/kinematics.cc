@@ -1,5 +1,7 @@
 #include "rig/kinematics.h"
 
+#include <cmath>
+
 namespace rig {
 
 Eigen::Matrix3d HeadFromCameraRotation() {
@@ -19,6 +21,11 @@ Eigen::Isometry3d RigGeometry::WorldFromHead(Side side, const CameraStage& stage
                            Eigen::AngleAxisd(stage.tilt_rad, Eigen::Vector3d::UnitX()))
                               .toRotationMatrix();
   return world_T_head;
+}
+
+CameraStage RigGeometry::FacingStage(Side side, double carriage_m, const Eigen::Vector3d& p_W) const {
+  const Eigen::Vector3d v = p_W - WorldFromHead(side, {carriage_m, 0, 0}).translation();
+  return {carriage_m, std::atan2(-v.x(), v.y()), std::atan2(v.z(), std::hypot(v.x(), v.y()))};
 }
 
 Eigen::Isometry3d RigGeometry::WorldFromCamera(Side side, const CameraStage& stage) const {

@@ -29,6 +29,11 @@ struct RigGeometry {
   Eigen::Isometry3d WorldFromHead(Side side, const CameraStage& stage) const;
   /// Pose of the camera (OpenCV frame) in the world.
   Eigen::Isometry3d WorldFromCamera(Side side, const CameraStage& stage) const;
+  /// Pan and tilt (two atan2 calls) that turn one head, its carriage at
+  /// `carriage_m`, so that its forward axis runs from the pan/tilt axes'
+  /// intersection through p_W: the camera faces p_W, exactly when the
+  /// optical centre lies on the axes (else Verge refines it).
+  CameraStage FacingStage(Side side, double carriage_m, const Eigen::Vector3d& p_W) const;
 };
 
 /// Rotation taking OpenCV camera axes to head axes (x -> x, y -> -z, z -> y).
