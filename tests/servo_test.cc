@@ -90,7 +90,8 @@ TEST_CASE("a guessed depth: the servo searches every depth and finds the surface
   const Eigen::Vector3d guess = OnLeftAxis(rig, block, 2.4, o.baseline_m);
   const fovea::FixationResult wide = fovea::Fixate(rig, empty, guess, matcher, o, 0, kEveryDepth);
   INFO("wide: " << wide.why << " fixated at " << wide.fixation_W.transpose() << ", residuals "
-                << Residuals(wide.servo));
+                << Residuals(wide.servo) << ", mutual mismatch "
+                << (wide.servo.mutual_mismatch_px ? *wide.servo.mutual_mismatch_px : 99.0));
   REQUIRE(wide.ok);
   CHECK(wide.servo.converged);
   CHECK((wide.fixation_W - block).norm() < 0.02);
@@ -113,4 +114,52 @@ TEST_CASE("a guessed depth on a periodic texture: no unique match, the point is 
   CHECK_FALSE(r.ok);
   CHECK(r.why.find("unique") != std::string::npos);
   CHECK(r.foveal.patches.size() == 0);
+}
+
+TEST_CASE("a point the right camera cannot see: the servo's match is not mutual, the point is refused",
+          "[fovea][servo][slow]") {
+  auto sim = NoisyScene("three_surfaces");
+  rig::Rig& rig = sim->rig();
+  const fovea::Nl1Matcher matcher;
+  const fovea::PatchMap empty;
+  // Plywood at 1.2 m just left of the slanted fabric's left edge (0.73 m
+  // deep): the left camera sees it past the edge, the right camera, 6 cm
+  // to the right, sees the fabric in front of it.
+  const Eigen::Vector3d hidden(-0.10, 1.2, 0.0);
+  fovea::FixationOptions o;
+  o.choose_placement = false;  // symmetric carriages: the right camera's view is blocked
+  SECTION("without the check the servo settles on another surface") {
+    o.servo.mutual_tolerance_px = 0;
+    const fovea::FixationResult r = fovea::Fixate(rig, empty, hidden, matcher, o, 0);
+    INFO(r.why << " fixated at " << r.fixation_W.transpose() << ", residuals " << Residuals(r.servo));
+    CHECK(r.servo.mutual);
+    CHECK_FALSE(r.servo.mutual_mismatch_px);
+    // The reverse search finds the plywood's window far from the fabric's.
+    const auto mismatch = fovea::MutualMismatch(r.servo.frame, o.servo, r.servo.residual_px);
+    REQUIRE(mismatch);
+    CHECK(std::abs(*mismatch) > 8);
+    // A false fixation: far from the plywood point on the left camera's axis.
+    if (r.ok) CHECK((r.fixation_W - hidden).norm() > 0.05);
+  }
+  SECTION("with it the point is refused before any matching") {
+    REQUIRE(o.servo.mutual_tolerance_px == 4.0);
+    const fovea::FixationResult r = fovea::Fixate(rig, empty, hidden, matcher, o, 0);
+    INFO(r.why << " fixated at " << r.fixation_W.transpose() << ", residuals " << Residuals(r.servo)
+                << ", mismatch " << (r.servo.mutual_mismatch_px ? *r.servo.mutual_mismatch_px : 0.0));
+    CHECK_FALSE(r.ok);
+    CHECK_FALSE(r.servo.mutual);
+    CHECK(r.why.find("mutual") != std::string::npos);
+    CHECK(r.foveal.patches.size() == 0);
+  }
+  SECTION("a visible point on the same plywood passes the check") {
+    const Eigen::Vector3d open(-0.25, 1.2, 0.1);
+    const fovea::FixationResult r = fovea::Fixate(rig, empty, open, matcher, o, 0);
+    INFO(r.why << " fixated at " << r.fixation_W.transpose() << ", residual " << r.servo.residual_px
+                << ", mismatch " << (r.servo.mutual_mismatch_px ? *r.servo.mutual_mismatch_px : 99.0));
+    REQUIRE(r.ok);
+    CHECK(r.servo.mutual);
+    REQUIRE(r.servo.mutual_mismatch_px);
+    CHECK(std::abs(*r.servo.mutual_mismatch_px) < 0.5);
+    CHECK((r.fixation_W - open).norm() < 0.02);
+  }
 }

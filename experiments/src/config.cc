@@ -130,6 +130,7 @@ std::vector<ConfigParam> ConfigParams(RunConfig* c) {
       {"foveal.servo_tolerance_px", "servoing stops below this centre disparity, pixels", &f.fixation.servo.tolerance_px, 0.01, 10},
       {"foveal.servo_search_px", "servoing's first search on a mapped point: +- this many pixels", &f.fixation.servo.search_px, 1, 300},
       {"foveal.servo_unique_ratio", "servoing on a hole searches every depth and keeps its best match only if its cost is below this share of the best elsewhere (1 = any)", &f.fixation.servo.unique_ratio, 0.01, 1},
+      {"foveal.servo_mutual_px", "beyond the paper: a converged servo's match must be mutual (the right centre window, searched back along the left image's row, lands within this many pixels of the left centre), else the point is refused (0 = no check)", &f.fixation.servo.mutual_tolerance_px, 0, 100},
       {"foveal.silent_confidence", "see foveal.silent_check: the wider search's match confidence needed to drop a band match", &f.fixation.foveal.silent_confidence, 0, 1},
       {"foveal.servo_max_steps", "servoing step budget", &f.fixation.servo.max_steps, 0, 50},
       {"selection.deterministic", "always fixate the composite's maximum instead of drawing", &f.selection.deterministic},

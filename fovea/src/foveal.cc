@@ -218,6 +218,11 @@ FixationResult Fixate(rig::Rig& rig, const PatchMap& map, const Eigen::Vector3d&
   r.servo = Servo(pair, r.vergence.state, options.servo, guessed_depths);
   r.servo_wall_s = Since(t_servo);
   r.motion_time_s = r.servo.motion_time_s;
+  if (!r.servo.mutual) {
+    r.why = "servoing's match is not mutual: the right camera's centre matches elsewhere in the left image";
+    r.compute_time_s = verge_s;
+    return r;
+  }
   if (guessed_depths && !r.servo.converged) {
     r.why = "servoing found no unique match for a point of guessed depth";
     r.compute_time_s = verge_s;

@@ -15,6 +15,7 @@ void ServoOptions::Check() const {
   if (!(tolerance_px > 0)) throw std::invalid_argument("servo: tolerance_px must be positive");
   if (max_steps < 1) throw std::invalid_argument("servo: max_steps must be >= 1");
   if (!(unique_ratio > 0 && unique_ratio <= 1)) throw std::invalid_argument("servo: unique_ratio must be in (0, 1]");
+  if (!(mutual_tolerance_px >= 0)) throw std::invalid_argument("servo: mutual_tolerance_px must be >= 0");
 }
 
 double NormalizedL1(const cv::Mat& left, int xl, int yl, const cv::Mat& right, int xr, int yr, int half) {
@@ -40,22 +41,23 @@ double NormalizedL1(const cv::Mat& left, int xl, int yl, const cv::Mat& right, i
 
 namespace {
 
-// The normalized L1 search of the left centre window along the right image's
-// row, over right-image offsets [lo, hi] pixels from the right principal
-// point; the minimum is refined by a parabola. A minimum at the edge of the
-// search is no match, and with `unique_ratio` < 1 neither is one whose cost
-// is not below that share of the best minimum elsewhere (outside the best's
-// window half-width).
-std::optional<double> SearchRow(const rig::StereoFrame& frame, const ServoOptions& o, int lo, int hi,
-                                double unique_ratio) {
-  const cv::Mat& l = frame.left.gray;
-  const cv::Mat& r = frame.right.gray;
-  const int xl = static_cast<int>(std::lround(frame.left.intrinsics.cx_px));
-  const int yl = static_cast<int>(std::lround(frame.left.intrinsics.cy_px));
-  const int xr0 = static_cast<int>(std::lround(frame.right.intrinsics.cx_px));
+// The normalized L1 search of the centre window of `from` (at its rounded
+// principal point) along the same row of `to`, over offsets [lo, hi] pixels
+// from `to`'s principal point; the minimum is refined by a parabola. A
+// minimum at the edge of the search is no match, and with `unique_ratio` < 1
+// neither is one whose cost is not below that share of the best minimum
+// elsewhere (outside the best's window half-width).
+std::optional<double> SearchRow(const rig::CameraView& from, const rig::CameraView& to, const ServoOptions& o,
+                                int lo, int hi, double unique_ratio) {
+  const cv::Mat& l = from.gray;
+  const cv::Mat& r = to.gray;
+  const int xl = static_cast<int>(std::lround(from.intrinsics.cx_px));
+  const int yl = static_cast<int>(std::lround(from.intrinsics.cy_px));
+  const int xr0 = static_cast<int>(std::lround(to.intrinsics.cx_px));
   const int h = o.window_half_px;
-  if (xl - h < 0 || yl - h < 0 || xl + h >= l.cols || yl + h >= l.rows || hi <= lo) return std::nullopt;
-  // No texture in the left window: nothing to servo on.
+  if (xl - h < 0 || yl - h < 0 || xl + h >= l.cols || yl + h >= l.rows || yl + h >= r.rows || hi <= lo)
+    return std::nullopt;
+  // No texture in the window: nothing to servo on.
   if (NormalizedL1(l, xl, yl, cv::Mat(l.size(), CV_8U, cv::Scalar(0)), xl, yl, h) < 2.0) return std::nullopt;
   const int n = hi - lo + 1;
   std::vector<double> cost(n, 1e300);
@@ -76,13 +78,26 @@ std::optional<double> SearchRow(const rig::StereoFrame& frame, const ServoOption
   const double c0 = cost[best - 1], c1 = cost[best], c2 = cost[best + 1];
   const double denom = c0 - 2 * c1 + c2;
   const double sub = denom > 0 ? 0.5 * (c0 - c2) / denom : 0.0;
-  return (xr0 + lo + best + sub) - frame.right.intrinsics.cx_px;
+  return (xr0 + lo + best + sub) - to.intrinsics.cx_px;
 }
 
 }  // namespace
 
 std::optional<double> CentreDisparity(const rig::StereoFrame& frame, const ServoOptions& o, int search_px) {
-  return SearchRow(frame, o, -search_px, search_px, 1.0);
+  return SearchRow(frame.left, frame.right, o, -search_px, search_px, 1.0);
+}
+
+std::optional<double> MutualMismatch(const rig::StereoFrame& frame, const ServoOptions& o, double residual_px) {
+  const auto reverse = SearchRow(frame.right, frame.left, o, -o.search_px, o.search_px, 1.0);
+  if (!reverse) return std::nullopt;
+  // Both searches centre their windows on the principal points' rounded
+  // pixels: the left one's match lies residual_px right of the right
+  // principal point, so the right one's lies as far left of the left one's,
+  // shifted by the two roundings.
+  const auto& kl = frame.left.intrinsics;
+  const auto& kr = frame.right.intrinsics;
+  const double expected = (std::lround(kl.cx_px) - kl.cx_px) + (std::lround(kr.cx_px) - kr.cx_px) - residual_px;
+  return *reverse - expected;
 }
 
 std::optional<double> CentreDisparity(const rig::StereoFrame& frame, const ServoOptions& o, const DepthRange& depths) {
@@ -105,7 +120,7 @@ std::optional<double> CentreDisparity(const rig::StereoFrame& frame, const Servo
   const double edge = std::max(kr.cx_px, kr.width_px - kr.cx_px);
   lo = std::max(lo, -edge);
   hi = std::min(hi, edge);
-  return SearchRow(frame, o, static_cast<int>(std::floor(lo)) - 1, static_cast<int>(std::ceil(hi)) + 1,
+  return SearchRow(frame.left, frame.right, o, static_cast<int>(std::floor(lo)) - 1, static_cast<int>(std::ceil(hi)) + 1,
                    o.unique_ratio);
 }
 
@@ -127,6 +142,11 @@ ServoResult Servo(rig::Rig& rig, const rig::StageState& start, const ServoOption
     result.residuals_px.push_back(*d);
     if (std::abs(*d) < o.tolerance_px) {
       result.converged = true;
+      if (o.mutual_tolerance_px > 0) {
+        result.mutual_mismatch_px = MutualMismatch(result.frame, o, *d);
+        result.mutual = result.mutual_mismatch_px && std::abs(*result.mutual_mismatch_px) < o.mutual_tolerance_px;
+        result.converged = result.mutual;
+      }
       break;
     }
     if (step >= o.max_steps) break;

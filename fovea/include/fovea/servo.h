@@ -28,6 +28,12 @@ struct ServoOptions {
   /// its cost is below this share of the best match elsewhere (a repeated
   /// texture's other copies): 1 keeps any minimum.
   double unique_ratio = 0.85;
+  /// Beyond the paper: a converged servo's match must be mutual, i.e. the
+  /// right image's centre window, searched +- search_px along the left
+  /// image's row, must find the left centre within this many pixels;
+  /// otherwise the right camera sees another surface (an occluder, a
+  /// repeated texture's copy) and the servo has not converged. 0: no check.
+  double mutual_tolerance_px = 4.0;
   void Check() const;
 };
 
@@ -52,8 +58,21 @@ std::optional<double> CentreDisparity(const rig::StereoFrame& frame, const Servo
 std::optional<double> CentreDisparity(const rig::StereoFrame& frame, const ServoOptions& options,
                                       const DepthRange& depths);
 
+/// The reverse of CentreDisparity: where the right image's centre window
+/// appears in the left image, searched +- options.search_px along its row,
+/// against where the left centre's match `residual_px` (CentreDisparity's
+/// answer) puts it; pixels, nullopt if the reverse search finds no match.
+/// Near 0 when both cameras see the same surface at their centres.
+std::optional<double> MutualMismatch(const rig::StereoFrame& frame, const ServoOptions& options,
+                                     double residual_px);
+
 struct ServoResult {
   bool converged = false;
+  /// With options.mutual_tolerance_px, once the residual is within
+  /// tolerance: MutualMismatch there, and whether it is within
+  /// mutual_tolerance_px (if not, converged is false).
+  std::optional<double> mutual_mismatch_px;
+  bool mutual = true;
   int iterations = 0;                ///< moves made after the first
   double residual_px = 0;            ///< last measured centre disparity
   std::vector<double> residuals_px;  ///< one per measurement
