@@ -4,6 +4,7 @@
 #include <limits>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
+#include <utility>
 
 #include "fovea/geometry.h"
 #include "fovea/timing.h"
@@ -218,16 +219,16 @@ FixationResult Fixate(rig::Rig& rig, const PatchMap& map, const Eigen::Vector3d&
   r.servo = Servo(pair, r.vergence.state, options.servo, guessed_depths);
   r.servo_wall_s = Since(t_servo);
   r.motion_time_s = r.servo.motion_time_s;
-  if (!r.servo.mutual) {
-    r.why = "servoing's match is not mutual: the right camera's centre matches elsewhere in the left image";
+  // A point refused after servoing: nothing was matched, only the vergence computed.
+  auto refuse = [&r, verge_s](std::string why) {
+    r.why = std::move(why);
     r.compute_time_s = verge_s;
     return r;
-  }
-  if (guessed_depths && !r.servo.converged) {
-    r.why = "servoing found no unique match for a point of guessed depth";
-    r.compute_time_s = verge_s;
-    return r;
-  }
+  };
+  if (!r.servo.mutual)
+    return refuse("servoing's match is not mutual: the right camera's centre matches elsewhere in the left image");
+  if (guessed_depths && !r.servo.converged)
+    return refuse("servoing found no unique match for a point of guessed depth");
   const rig::StereoFrame& frame = r.servo.frame;
   // Where the two optical axes (the principal points' rays) meet.
   const auto& kl = frame.left.intrinsics;
@@ -236,11 +237,8 @@ FixationResult Fixate(rig::Rig& rig, const PatchMap& map, const Eigen::Vector3d&
                                         PixelRay(frame.right.world_T_camera, kr, {kr.cx_px, kr.cy_px}));
   r.fixation_W = meet ? meet->p_W : p_W;
   const double depth = (frame.left.world_T_camera.inverse() * r.fixation_W).z();
-  if (depth < options.min_depth_m) {
-    r.why = "servoing settled at " + std::to_string(depth) + " m, nearer than idr.z_min_m: a false match";
-    r.compute_time_s = verge_s;
-    return r;
-  }
+  if (depth < options.min_depth_m)
+    return refuse("servoing settled at " + std::to_string(depth) + " m, nearer than idr.z_min_m: a false match");
   r.foveal = FovealStereo(frame, r.fixation_W, map, matcher, options.foveal, fixation);
   r.compute_time_s = verge_s + r.foveal.compute_time_s;
   r.ok = true;

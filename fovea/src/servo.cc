@@ -120,8 +120,8 @@ std::optional<double> CentreDisparity(const rig::StereoFrame& frame, const Servo
   const double edge = std::max(kr.cx_px, kr.width_px - kr.cx_px);
   lo = std::max(lo, -edge);
   hi = std::min(hi, edge);
-  return SearchRow(frame.left, frame.right, o, static_cast<int>(std::floor(lo)) - 1, static_cast<int>(std::ceil(hi)) + 1,
-                   o.unique_ratio);
+  return SearchRow(frame.left, frame.right, o, static_cast<int>(std::floor(lo)) - 1,
+                   static_cast<int>(std::ceil(hi)) + 1, o.unique_ratio);
 }
 
 ServoResult Servo(rig::Rig& rig, const rig::StageState& start, const ServoOptions& o,
