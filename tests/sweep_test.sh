@@ -62,7 +62,17 @@ for f in /proc/[0-9]*/cmdline; do
   c=$(tr '\0' ' ' < "$f" 2>/dev/null) || continue
   case $c in *"$work/killed/configs"*) fail "a run outlived the killed sweep: $c" ;; esac
 done
-"$fovea" sweep "$sweep" --out "$work/killed" --jobs 2 2> "$work/restart.log"
+# Without --resume the folder is refused (it holds the sweep already),
+# exit 2, and nothing in it changes.
+before=$(find "$work/killed" -type f | sort | xargs md5sum)
+set +e
+"$fovea" sweep "$sweep" --out "$work/killed" --jobs 2 2> "$work/refused.log"
+code=$?
+set -e
+[ "$code" -eq 2 ] || fail "a sweep into a folder holding it without --resume exited $code, not 2"
+grep -q "pass --resume" "$work/refused.log" || fail "the refusal does not say --resume: $(cat "$work/refused.log")"
+[ "$before" = "$(find "$work/killed" -type f | sort | xargs md5sum)" ] || fail "the refused sweep changed the folder"
+"$fovea" sweep "$sweep" --out "$work/killed" --jobs 2 --resume 2> "$work/restart.log"
 grep -q "$n already done" "$work/restart.log" || fail "the restart did not skip the $n finished runs: $(head -1 "$work/restart.log")"
 ls -a "$work/killed/runs" | grep -q partial && fail "staging folders left behind"
 strip "$work/killed/results.csv" > "$work/killed.csv"

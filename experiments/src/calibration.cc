@@ -22,7 +22,7 @@ std::vector<std::string> Glob(const std::string& pattern) {
   if (::glob(pattern.c_str(), 0, nullptr, &g) == 0)
     for (size_t i = 0; i < g.gl_pathc; ++i) files.emplace_back(g.gl_pathv[i]);
   globfree(&g);
-  if (files.empty()) throw UsageError("no files match '" + pattern + "'");
+  if (files.empty()) throw UsageError("no files match '" + rig::ClipForMessage(pattern) + "'");
   std::sort(files.begin(), files.end());
   return files;
 }
@@ -43,29 +43,44 @@ CalibrationResult CalibrateStereo(const std::vector<std::string>& left_files,
   cv::Size size;
   for (size_t i = 0; i < left_files.size(); ++i) {
     std::vector<cv::Point2f> corners[2];
+    cv::Mat img[2];
     bool found = true;
     for (int s = 0; s < 2; ++s) {
       const std::string& file = s == 0 ? left_files[i] : right_files[i];
-      const cv::Mat img = cv::imread(file, cv::IMREAD_GRAYSCALE);
-      if (img.empty()) throw UsageError("calibrate: cannot read image '" + file + "'");
-      if (size.empty()) size = img.size();
-      if (img.size() != size)
-        throw UsageError("calibrate: '" + file + "' is " + std::to_string(img.cols) + "x" + std::to_string(img.rows) +
-                         ", the first image is " + std::to_string(size.width) + "x" + std::to_string(size.height));
+      rig::CheckInputFile(file, "calibrate: image");
+      img[s] = cv::imread(file, cv::IMREAD_GRAYSCALE);
+      if (img[s].empty()) throw UsageError("calibrate: cannot read image '" + rig::ClipForMessage(file) + "'");
+      if (size.empty()) size = img[s].size();
+      if (img[s].size() != size)
+        throw UsageError("calibrate: '" + rig::ClipForMessage(file) + "' is " + std::to_string(img[s].cols) + "x" +
+                         std::to_string(img[s].rows) + ", the first image is " + std::to_string(size.width) + "x" +
+                         std::to_string(size.height));
       // The sector-based detector first (robust to noise, sub-pixel
       // accurate), the classic one with sub-pixel refinement as a fallback.
       if (!found) continue;
-      if (!cv::findChessboardCornersSB(img, pattern, corners[s], cv::CALIB_CB_ACCURACY)) {
-        found = cv::findChessboardCorners(img, pattern, corners[s],
+      if (!cv::findChessboardCornersSB(img[s], pattern, corners[s], cv::CALIB_CB_ACCURACY)) {
+        found = cv::findChessboardCorners(img[s], pattern, corners[s],
                                           cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE);
         if (found)
-          cv::cornerSubPix(img, corners[s], cv::Size(5, 5), cv::Size(-1, -1),
+          cv::cornerSubPix(img[s], corners[s], cv::Size(5, 5), cv::Size(-1, -1),
                            cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 1e-4));
       }
     }
     if (!found) {
       result.skipped.push_back(left_files[i]);
       continue;
+    }
+    // A board with more corners than --board says holds sub-patterns of the
+    // stated size that the detectors find too (and left and right may pick
+    // different ones): refuse it.
+    for (int s = 0; s < 2; ++s) {
+      std::vector<cv::Point2f> more;
+      for (const cv::Size bigger : {cv::Size(cols + 1, rows), cv::Size(cols, rows + 1)})
+        if (cv::findChessboardCornersSB(img[s], bigger, more))
+          throw UsageError("calibrate: '" + rig::ClipForMessage(s == 0 ? left_files[i] : right_files[i]) +
+                           "' shows a board of at least " + std::to_string(bigger.width) + "x" +
+                           std::to_string(bigger.height) + " inner corners, not the " + std::to_string(cols) + "x" +
+                           std::to_string(rows) + " of --board: count the inner corners again");
     }
     object.push_back(board);
     left_points.push_back(corners[0]);

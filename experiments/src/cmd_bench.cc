@@ -18,7 +18,10 @@ struct BenchRenderArgs {
 
 int BenchRender(const BenchRenderArgs& args) {
   using Clock = std::chrono::steady_clock;
-  auto sim = args.scene.Load();
+  RunConfig config;
+  config.rig.noise.read_noise_sigma_dn = 0;  // rendering speed alone, unless --noise
+  args.scene.ApplyTo(&config);
+  auto sim = LoadSceneOf(config);
   rig::Rig& rig = sim->rig();
   rig.Capture();  // warm-up: texture upload, JIT of the software rasterizer
   auto seconds = [](Clock::time_point t0) {
@@ -98,18 +101,20 @@ namespace {
 
 struct BenchFixationArgs {
   SceneOptions scene;
-  std::vector<double> point{0.0, 0.89, 0.0};
+  std::vector<std::string> point{"0", "0.89", "0"};
   bool json = false;
 };
 
 int BenchFixation(const BenchFixationArgs& args) {
   using Clock = std::chrono::steady_clock;
   auto ms = [](Clock::time_point t0) { return 1e3 * std::chrono::duration<double>(Clock::now() - t0).count(); };
-  auto sim = args.scene.Load();
+  RunConfig config;  // the run's defaults: noise on
+  args.scene.ApplyTo(&config);
+  const Eigen::Vector3d p(*ParseNumber(args.point[0]), *ParseNumber(args.point[1]), *ParseNumber(args.point[2]));
+  auto sim = LoadSceneOf(config);
   rig::Rig& rig = sim->rig();
   const fovea::IdrResult idr = fovea::RunIdr(rig, {});
   const fovea::Nl1Matcher nl1;
-  const Eigen::Vector3d p(args.point[0], args.point[1], args.point[2]);
   const fovea::FixationResult r = fovea::Fixate(rig, idr.map, p, nl1, {});
   if (!r.ok) throw std::runtime_error("cannot fixate the benchmark point: " + r.why);
   const FovealScore score = ScoreFoveal(r, sim->truth());
@@ -196,10 +201,12 @@ int BenchFixation(const BenchFixationArgs& args) {
 void AddBenchFixationCommand(CLI::App& bench, std::function<int()>* run) {
   auto args = std::make_shared<BenchFixationArgs>();
   args->scene.scene = "cylinder_planes";
-  args->scene.noise_sigma_dn = 2.0;
   CLI::App* cmd = bench.add_subcommand("fixation", "foveated matching vs full-resolution NL1 vs StereoSGBM");
   args->scene.Register(cmd, /*with_state=*/false);
-  cmd->add_option("--point", args->point, "fixation point X Y Z, metres")->expected(3)->capture_default_str();
+  cmd->add_option("--point", args->point, "fixation point X Y Z, metres")
+      ->expected(3)
+      ->check(NumberIn(-100, 100))
+      ->capture_default_str();
   cmd->add_flag("--json", args->json, "one JSON object on stdout");
   cmd->callback([args, run] { *run = [args] { return BenchFixation(*args); }; });
 }

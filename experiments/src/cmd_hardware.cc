@@ -7,6 +7,7 @@
 #include <thread>
 
 #include "commands.h"
+#include "config.h"
 #include "output.h"
 #include "rig/indexer_emulator.h"
 
@@ -22,9 +23,14 @@ void AddHardwareCommands(CLI::App& app, std::function<int()>* run) {
   CLI::App* cmd = app.add_subcommand("indexer-emulator",
                                      "emulate the chain of indexers on a pseudo-terminal (prints its path)");
   cmd->add_option("--units", *units, "unit addresses on the chain")->delimiter(',')->check(CLI::Range(1, 99));
-  cmd->add_option("--seconds", *seconds, "stop after this long (0 = until SIGINT/SIGTERM)")->check(CLI::NonNegativeNumber);
+  cmd->add_option("--seconds", *seconds, "stop after this long (0 = until SIGINT/SIGTERM)")
+      ->check(NumberIn(0, 1e7));
   cmd->callback([units, seconds, run] {
     *run = [units, seconds] {
+      for (size_t i = 0; i < units->size(); ++i)
+        for (size_t j = 0; j < i; ++j)
+          if ((*units)[i] == (*units)[j])
+            throw UsageError("--units: address " + std::to_string((*units)[i]) + " appears twice");
       rig::IndexerEmulator emulator(*units);
       std::printf("%s\n", emulator.Path().c_str());
       std::fflush(stdout);

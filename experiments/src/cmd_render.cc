@@ -21,18 +21,24 @@ nlohmann::json PoseJson(const Eigen::Isometry3d& pose) {
 struct RenderArgs {
   SceneOptions scene;
   std::string out;
+  bool force = false;
 };
 
 int Render(const RenderArgs& args) {
-  auto sim = args.scene.Load();
+  RunConfig config;
+  config.rig.noise.read_noise_sigma_dn = 0;  // render shows the scene as it is, unless --noise
+  args.scene.ApplyTo(&config);
+  const std::optional<rig::StageState> asked = args.scene.TargetState();
+  OutputFolder folder(args.out, "--out", ExistingPolicy(args.force));
+  auto sim = LoadSceneOf(config);
   rig::Rig& rig = sim->rig();
-  const rig::StageState target = args.scene.TargetState(rig.Home());
+  const rig::StageState target = asked ? *asked : rig.Home();
   const std::string violation = rig.Limits().Violation(target);
   if (!violation.empty()) throw UsageError("stage state refused: " + violation);
 
   const rig::MoveResult move = rig.MoveTo(target);
   const rig::StereoFrame frame = rig.Capture({/*color=*/true});
-  EnsureDirectory(args.out);
+  const std::string dir = folder.path();
   nlohmann::json meta;
   meta["scene"] = sim->scene_path();
   meta["motion_time_s"] = move.motion_time_s;
@@ -43,20 +49,21 @@ int Render(const RenderArgs& args) {
     const rig::CameraView& view = frame[side];
     const std::string name = rig::SideName(side);
     const sim::TrueView truth = sim->truth().Render(view.world_T_camera, view.intrinsics);
-    WriteImageAtomic(args.out + "/" + name + ".png", view.bgr);
-    WriteImageAtomic(args.out + "/depth_" + name + ".png", ColorizeDepth(truth.depth_m));
+    WriteImageAtomic(dir + "/" + name + ".png", view.bgr);
+    WriteImageAtomic(dir + "/depth_" + name + ".png", ColorizeDepth(truth.depth_m));
     cv::Mat depth_mm;
     truth.depth_m.convertTo(depth_mm, CV_16U, 1000.0);
-    WriteImageAtomic(args.out + "/depth_" + name + "_mm.png", depth_mm);
+    WriteImageAtomic(dir + "/depth_" + name + "_mm.png", depth_mm);
     const rig::CameraIntrinsics& k = view.intrinsics;
     meta[name] = {{"intrinsics",
                    {{"fx_px", k.fx_px}, {"fy_px", k.fy_px}, {"cx_px", k.cx_px}, {"cy_px", k.cy_px},
                     {"width_px", k.width_px}, {"height_px", k.height_px}}},
                   {"world_T_camera", PoseJson(view.world_T_camera)}};
   }
-  WriteTextAtomic(args.out + "/render.json", meta.dump(2) + "\n");
+  WriteTextAtomic(dir + "/render.json", meta.dump(2) + "\n");
+  folder.Commit();
   std::fprintf(stderr, "fovea render: %s at %s -> %s\n", sim->scene_path().c_str(),
-               frame.state.ToString().c_str(), args.out.c_str());
+               frame.state.ToString().c_str(), folder.target().c_str());
   return 0;
 }
 
@@ -67,7 +74,8 @@ void AddRenderCommand(CLI::App& app, std::function<int()>* run) {
   CLI::App* cmd = app.add_subcommand(
       "render", "write both cameras' images and their colour-mapped true depth as PNG");
   args->scene.Register(cmd, /*with_state=*/true);
-  cmd->add_option("--out", args->out, "output folder")->required();
+  cmd->add_option("--out", args->out, "output folder (new, or empty)")->required();
+  AddForceFlag(cmd, &args->force);
   cmd->callback([args, run] { *run = [args] { return Render(*args); }; });
 }
 

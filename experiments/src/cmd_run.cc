@@ -16,6 +16,7 @@
 #include "output.h"
 #include "run_eval.h"
 #include "run_output.h"
+#include "scene_options.h"
 #include "rig/hardware_rig.h"
 #include "rig/indexer_emulator.h"
 #include "scenes/catalog.h"
@@ -29,12 +30,11 @@ using fovea::Since;
 
 struct RunArgs {
   std::string config_path;
-  std::string scene;
-  std::optional<uint64_t> seed;
-  std::optional<int> fixations;
+  std::string scene, seed, fixations;  // as typed; "" = the config's
   bool deterministic = false;
   std::vector<std::string> set;
   std::string out;
+  bool force = false;
 };
 
 nlohmann::json Vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
@@ -92,46 +92,16 @@ nlohmann::json RecordJson(const fovea::FixationRecord& r, const MapScore& score)
   return j;
 }
 
-// The output folder is built under a temporary name and renamed into place
-// at the end, so that DIR holds a complete run or nothing.
-class StagingFolder {
- public:
-  explicit StagingFolder(const std::string& out) : out_(out) {
-    const fs::path p = fs::absolute(out).lexically_normal();
-    tmp_ = (p.parent_path() / ("." + p.filename().string() + ".partial-" + std::to_string(getpid()))).string();
-    std::error_code ec;
-    fs::remove_all(tmp_, ec);
-    EnsureDirectory(tmp_);
-  }
-  ~StagingFolder() {
-    std::error_code ec;
-    if (!committed_) fs::remove_all(tmp_, ec);
-  }
-  const std::string& path() const { return tmp_; }
-  void Commit() {
-    std::error_code ec;
-    if (fs::exists(out_)) fs::remove_all(out_, ec);
-    if (ec) throw std::runtime_error("cannot replace '" + out_ + "': " + ec.message());
-    fs::rename(tmp_, out_, ec);
-    if (ec) throw std::runtime_error("cannot write '" + out_ + "': " + ec.message());
-    committed_ = true;
-  }
-
- private:
-  std::string out_, tmp_;
-  bool committed_ = false;
-};
-
 RunConfig EffectiveConfig(const RunArgs& args) {
   RunConfig c = args.config_path.empty() ? RunConfig{} : LoadConfig(args.config_path);
   for (const std::string& kv : args.set) {
     const size_t eq = kv.find('=');
-    if (eq == std::string::npos) throw UsageError("--set expects KEY=VALUE, got '" + kv + "'");
+    if (eq == std::string::npos) throw UsageError("--set expects KEY=VALUE, got '" + rig::ClipForMessage(kv) + "'");
     SetParam(&c, kv.substr(0, eq), kv.substr(eq + 1));
   }
-  if (!args.scene.empty()) c.scene = args.scene;
-  if (args.seed) c.seed = *args.seed;
-  if (args.fixations) SetParam(&c, "loop.fixations", std::to_string(*args.fixations));
+  if (!args.scene.empty()) SetParamFromFlag(&c, "--scene", "scene", args.scene);
+  if (!args.seed.empty()) SetParamFromFlag(&c, "--seed", "seed", args.seed);
+  if (!args.fixations.empty()) SetParamFromFlag(&c, "--fixations", "loop.fixations", args.fixations);
   if (args.deterministic) c.fovea.selection.deterministic = true;
   if (c.scene.empty()) c.scene = scenes::kDefaultScene;
   c.Check();
@@ -140,13 +110,10 @@ RunConfig EffectiveConfig(const RunArgs& args) {
 
 // The static StereoSGBM baseline, scored like a FOVEA run: summary.json with
 // the same keys, map.ply, map.png, reference.png, an empty fixations.jsonl.
-int RunStatic(const RunConfig& config, const std::string& out, Clock::time_point t_wall) {
-  sim::SimRigConfig rig_config = config.rig;
-  rig_config.seed = config.seed;
-  auto sim = scenes::LoadScene(config.scene, rig_config);
+int RunStatic(const RunConfig& config, OutputFolder& folder, Clock::time_point t_wall) {
+  auto sim = LoadSceneOf(config);
   rig::Rig& rig = sim->rig();
-  StagingFolder staging(out);
-  const std::string dir = staging.path();
+  const std::string dir = folder.path();
   WriteTextAtomic(dir + "/config.yaml", DumpConfig(config));
   const ReferenceView ref = MakeReferenceView(rig, sim->truth());
   StaticSgbmOptions options;
@@ -158,9 +125,8 @@ int RunStatic(const RunConfig& config, const std::string& out, Clock::time_point
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   for (const fovea::Patch& p : r.map.patches()) centre += p.Centre() / double(r.map.size());
   char caption[200];
-  std::snprintf(caption, sizeof caption, "%s, static StereoSGBM at %.3f m: coverage %.3f, median error %.2f mm",
-                fs::path(sim->scene_path()).stem().c_str(), r.baseline_m, score.coverage,
-                1e3 * score.overall.median_abs_error_m);
+  std::snprintf(caption, sizeof caption, "%s, static StereoSGBM at %.3f m: %s",
+                fs::path(sim->scene_path()).stem().c_str(), r.baseline_m, ScoreLine(score, true).c_str());
   WriteImageAtomic(dir + "/map.png", MapSnapshot(r.map, ref, centre, caption));
   WriteImageAtomic(dir + "/reference.png", ref.view.gray);
   WriteTextAtomic(dir + "/map.ply", PatchMapPly(r.map));
@@ -176,12 +142,9 @@ int RunStatic(const RunConfig& config, const std::string& out, Clock::time_point
   summary["compute_time_s"] = r.compute_time_s;
   summary["wall_time_s"] = Since(t_wall);
   WriteTextAtomic(dir + "/summary.json", summary.dump(2) + "\n");
-  staging.Commit();
-  std::fprintf(stderr,
-               "fovea run: static StereoSGBM, baseline %.3f m: coverage %.3f, median error %.2f mm (%.3f%% of depth), "
-               "RMSE %.2f mm -> %s\n",
-               r.baseline_m, score.coverage, 1e3 * score.overall.median_abs_error_m,
-               100 * score.overall.median_rel_error, 1e3 * score.overall.rmse_m, out.c_str());
+  folder.Commit();
+  std::fprintf(stderr, "fovea run: static StereoSGBM, baseline %.3f m: %s -> %s\n", r.baseline_m,
+               ScoreLine(score).c_str(), folder.target().c_str());
   return 0;
 }
 
@@ -231,19 +194,17 @@ std::unique_ptr<rig::HardwareRig> MakeHardwareRig(const RunConfig& c, std::uniqu
 int Run(const RunArgs& args) {
   const auto t_wall = Clock::now();
   const RunConfig config = EffectiveConfig(args);
-  if (config.method == "static_sgbm") return RunStatic(config, args.out, t_wall);
-  sim::SimRigConfig rig_config = config.rig;
-  rig_config.seed = config.seed;
-  if (!rig_config.record_dir.empty()) EnsureDirectory(rig_config.record_dir);
+  OutputFolder folder(args.out, "--out", ExistingPolicy(args.force));
+  if (config.method == "static_sgbm") return RunStatic(config, folder, t_wall);
   // The scene's model: the simulated rig, and the ground truth every run is
   // scored against (on hardware, the model of the scene in front of it).
-  auto sim = scenes::LoadScene(config.scene, rig_config);
+  auto sim = LoadSceneOf(config);
   std::unique_ptr<rig::IndexerEmulator> emulator;
   std::unique_ptr<rig::HardwareRig> hardware;
   if (config.hardware.type == "hardware") hardware = MakeHardwareRig(config, &emulator);
   rig::Rig& rig = hardware ? static_cast<rig::Rig&>(*hardware) : sim->rig();
-  StagingFolder staging(args.out);
-  const std::string dir = staging.path();
+  if (!config.rig.record_dir.empty()) EnsureDirectory(config.rig.record_dir);
+  const std::string dir = folder.path();
   WriteTextAtomic(dir + "/config.yaml", DumpConfig(config));
 
   auto t = Clock::now();
@@ -269,19 +230,17 @@ int Run(const RunArgs& args) {
     if (r.ok && r.fixation == 1) view_target = r.fixation_W;
     std::fprintf(stderr,
                  "fovea run: fixation %2d/%d%s at (%+.3f, %.3f, %+.3f): %3d new patches, map %4d idr / %4d "
-                 "peripheral / %4d foveal, coverage %.3f, foveal %.3f, median error %.2f mm\n",
+                 "peripheral / %4d foveal, %s\n",
                  r.fixation, config.fovea.fixations, r.ok ? "" : " REFUSED", r.target_W.x(), r.target_W.y(),
                  r.target_W.z(), r.integration.added, r.map_by_level[0], r.map_by_level[1], r.map_by_level[2],
-                 score.coverage, score.foveal_coverage, 1e3 * score.overall.median_abs_error_m);
+                 ScoreLine(score, /*brief=*/true).c_str());
     if (!r.ok) std::fprintf(stderr, "fovea run:   refused: %s\n", r.why.c_str());
     t0 = Clock::now();
     if (r.ok && snapshots.count(r.fixation)) {
       char name[64], caption[200];
       std::snprintf(name, sizeof name, "/map_after_%02d.png", r.fixation);
-      std::snprintf(caption, sizeof caption,
-                    "%s after fixation %d: coverage %.3f, foveal %.3f, median error %.2f mm",
-                    fs::path(sim->scene_path()).stem().c_str(), r.fixation, score.coverage, score.foveal_coverage,
-                    1e3 * score.overall.median_abs_error_m);
+      std::snprintf(caption, sizeof caption, "%s after fixation %d: %s", fs::path(sim->scene_path()).stem().c_str(),
+                    r.fixation, ScoreLine(score, /*brief=*/true).c_str());
       WriteImageAtomic(dir + name, MapSnapshot(map, ref, view_target, caption));
     }
     output_s += Since(t0);
@@ -341,13 +300,9 @@ int Run(const RunArgs& args) {
                        {"scoring", scoring_s},
                        {"outputs", output_s}};
   WriteTextAtomic(dir + "/summary.json", summary.dump(2) + "\n");
-  staging.Commit();
-  std::fprintf(stderr,
-               "fovea run: %d fixations (%s): coverage %.3f, foveal %.3f, median error %.2f mm (%.3f%% of depth), "
-               "RMSE %.2f mm -> %s\n",
-               run.fixations_done, run.stop_reason.c_str(), final_score.coverage, final_score.foveal_coverage,
-               1e3 * final_score.overall.median_abs_error_m, 100 * final_score.overall.median_rel_error,
-               1e3 * final_score.overall.rmse_m, args.out.c_str());
+  folder.Commit();
+  std::fprintf(stderr, "fovea run: %d fixations (%s): %s -> %s\n", run.fixations_done, run.stop_reason.c_str(),
+               ScoreLine(final_score).c_str(), folder.target().c_str());
   std::fprintf(stderr,
                "fovea run: wall %.1f s: servo (moves, captures) %.1f, IDR %.1f (compute), foveal stereo %.1f "
                "(matching %.1f), selection %.1f, integration %.1f, scoring %.1f, pictures %.1f; simulated motion "
@@ -365,10 +320,11 @@ void AddRunCommand(CLI::App& app, std::function<int()>* run) {
   cmd->add_option("--scene", args->scene, "catalog scene name or path (overrides the config)");
   cmd->add_option("--config", args->config_path, "YAML configuration (see fovea config --dump)");
   cmd->add_option("--seed", args->seed, "the one seed (overrides the config)");
-  cmd->add_option("--fixations", args->fixations, "fixations to make (overrides the config)");
+  cmd->add_option("--fixations", args->fixations, "fixations to make (overrides the config: loop.fixations)");
   cmd->add_flag("--deterministic", args->deterministic, "always fixate the composite's maximum");
   cmd->add_option("--set", args->set, "KEY=VALUE: set one parameter (repeatable)");
-  cmd->add_option("--out", args->out, "output folder")->required();
+  cmd->add_option("--out", args->out, "output folder (new, or empty)")->required();
+  AddForceFlag(cmd, &args->force);
   cmd->callback([args, run] { *run = [args] { return Run(*args); }; });
 
   auto dump_args = std::make_shared<RunArgs>();

@@ -2,6 +2,7 @@
 // restartable and shardable; fovea collect: merge shards and write the CSV;
 // fovea report: an HTML page for a run or a sweep.
 #include <fcntl.h>
+#include <sys/file.h>
 #include <signal.h>
 #include <sys/prctl.h>
 #include <sys/wait.h>
@@ -104,8 +105,72 @@ void RemoveStaging(const std::string& runs_dir, const std::string& id) {
 struct SweepArgs {
   std::string file, out, shard;
   int jobs = -1;
-  bool no_report = false;
+  bool no_report = false, resume = false;
 };
+
+// Holds the sweep folder's locks while a sweep runs in it, so that two
+// sweeps never run the same runs: a whole sweep takes `.sweep.lock`
+// exclusively; a shard takes it shared (shards of one sweep may share a
+// folder) and its own `.shard-I-of-N.lock` exclusively. The lock files hold
+// the pid. flock: released when the process ends, however it ends.
+class SweepLock {
+ public:
+  SweepLock(const std::string& dir, int shard_i, int shard_n) {
+    const bool whole = shard_n == 1;
+    Take(dir + "/.sweep.lock", whole ? LOCK_EX : LOCK_SH, dir);
+    if (!whole) Take(dir + "/.shard-" + std::to_string(shard_i) + "-of-" + std::to_string(shard_n) + ".lock", LOCK_EX, dir);
+  }
+  ~SweepLock() {
+    for (const int fd : fds_) close(fd);
+  }
+  SweepLock(const SweepLock&) = delete;
+  SweepLock& operator=(const SweepLock&) = delete;
+
+ private:
+  void Take(const std::string& path, int mode, const std::string& dir) {
+    const int fd = open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd < 0) throw std::runtime_error("cannot lock the sweep folder '" + rig::ClipForMessage(dir) + "'");
+    fds_.push_back(fd);
+    if (flock(fd, mode | LOCK_NB) != 0) {
+      char pid[32] = "";
+      const ssize_t n = pread(fd, pid, sizeof pid - 1, 0);
+      if (n > 0) pid[n] = '\0';
+      throw std::runtime_error("'" + rig::ClipForMessage(dir) + "' is in use by another fovea sweep" +
+                               (n > 0 ? std::string(" (pid ") + pid + ")" : std::string()) +
+                               "; wait for it to end, or choose another --out");
+    }
+    if (mode == LOCK_EX) {
+      const std::string me = std::to_string(getpid());
+      if (ftruncate(fd, 0) != 0 || pwrite(fd, me.data(), me.size(), 0) < 0) {
+        // The pid is only for the message; the lock holds without it.
+      }
+    }
+  }
+  std::vector<int> fds_;
+};
+
+// The output-folder policy for a sweep: a new or empty folder, or, with
+// --resume, one holding this very sweep.
+void CheckSweepFolder(const std::string& dir, const std::string& grid_text, bool resume) {
+  std::error_code ec;
+  if (!fs::exists(fs::symlink_status(dir, ec)) || (fs::is_directory(dir) && fs::is_empty(dir, ec))) return;
+  const std::string at = "--out: '" + rig::ClipForMessage(dir) + "'";
+  if (!fs::is_directory(fs::symlink_status(dir, ec))) throw UsageError(at + " exists and is not a folder");
+  if (!fs::exists(dir + "/grid.json"))
+    throw UsageError(at + " exists and is not a sweep folder (no grid.json); choose another --out");
+  if (ReadFile(dir + "/grid.json") != grid_text)
+    throw UsageError(at + " holds a different sweep (its grid.json differs); choose another --out");
+  if (!resume) throw UsageError(at + " holds this sweep already; pass --resume to continue it");
+}
+
+// A rough duration of one run, seconds on one core of the 2-core
+// development machine: scene load and reference view, then per fixation
+// (measured: 25 fixations at 640x480 about 15 s, 3 at 320x240 about 7 s).
+double RoughRunSeconds(const RunConfig& c) {
+  const double pixels = double(c.rig.width_px) * c.rig.height_px / (640.0 * 480.0);
+  if (c.method == "static_sgbm") return 5 + 2 * pixels;
+  return 5 + pixels * (2 + 0.35 * c.fovea.fixations);
+}
 
 // Writes results.csv (and report.html) when every run has a result;
 // returns the ids without one.
@@ -124,12 +189,14 @@ int RunSweep(const SweepArgs& args) {
   const auto [shard_i, shard_n] = args.shard.empty() ? std::pair<int, int>{1, 1} : ParseShard(args.shard);
   int jobs = args.jobs >= 0 ? args.jobs : sweep.jobs;
   if (jobs == 0) jobs = std::max(1u, std::thread::hardware_concurrency());
-  const std::string dir = args.out.empty() ? "out/sweeps/" + fs::path(args.file).stem().string() : args.out;
+  const std::string dir =
+      NormalizeOutputPath(args.out.empty() ? "out/sweeps/" + fs::path(args.file).stem().string() : args.out, "--out");
   const nlohmann::json grid = GridJson(sweep);
   const std::string grid_text = grid.dump(1) + "\n";
-  if (fs::exists(dir + "/grid.json") && ReadFile(dir + "/grid.json") != grid_text)
-    throw UsageError("'" + dir + "' holds a different sweep (its grid.json differs); choose another --out");
+  CheckSweepFolder(dir, grid_text, args.resume);
   const std::string exe = SelfExe();
+  EnsureDirectory(dir);
+  const SweepLock lock(dir, shard_i, shard_n);
   EnsureDirectory(dir + "/runs");
   EnsureDirectory(dir + "/configs");
   EnsureDirectory(dir + "/logs");
@@ -139,11 +206,19 @@ int RunSweep(const SweepArgs& args) {
   std::vector<const SweepRun*> mine, pending;
   for (size_t i = 0; i < sweep.runs.size(); ++i)
     if (static_cast<int>(i % shard_n) == shard_i - 1) mine.push_back(&sweep.runs[i]);
+  double rough_s = 0;
   for (const SweepRun* r : mine)
-    if (!fs::exists(dir + "/runs/" + r->id + "/summary.json")) pending.push_back(r);
-  std::fprintf(stderr, "fovea sweep: %zu runs%s, %zu already done, %zu to run on %d parallel jobs -> %s\n", mine.size(),
+    if (!fs::exists(dir + "/runs/" + r->id + "/summary.json")) {
+      pending.push_back(r);
+      rough_s += RoughRunSeconds(r->config);
+    }
+  std::fprintf(stderr,
+               "fovea sweep: %zu runs%s, %zu already done, %zu to run on %d parallel jobs (roughly %s) -> %s\n",
+               mine.size(),
                shard_n > 1 ? (" in shard " + args.shard + " of " + std::to_string(sweep.runs.size())).c_str() : "",
-               mine.size() - pending.size(), pending.size(), jobs, dir.c_str());
+               mine.size() - pending.size(), pending.size(), jobs,
+               Duration(rough_s / std::max(1, std::min<int>(jobs, static_cast<int>(pending.size())))).c_str(),
+               dir.c_str());
 
   struct sigaction sa {};
   sa.sa_handler = OnSignal;
@@ -176,7 +251,8 @@ int RunSweep(const SweepArgs& args) {
   if (g_stop) {
     for (const auto& [pid, run] : running) kill(pid, SIGTERM);
     for (const auto& [pid, run] : running) waitpid(pid, nullptr, 0);
-    std::fprintf(stderr, "\nfovea sweep: stopped by signal %d; the same command resumes it\n", int(g_stop));
+    std::fprintf(stderr, "\nfovea sweep: stopped by signal %d; the same command with --resume resumes it\n",
+                 int(g_stop));
     return 130;
   }
   for (const std::string& id : failed)
@@ -203,11 +279,20 @@ void CopyRun(const fs::path& from, const fs::path& runs_dir, const std::string& 
   if (ec) throw std::runtime_error("cannot write '" + (runs_dir / id).string() + "': " + ec.message());
 }
 
-int Collect(const std::string& dir, const std::vector<std::string>& shards, bool report) {
+int Collect(const std::string& dir_arg, const std::vector<std::string>& shards, bool report) {
+  const std::string dir = NormalizeOutputPath(dir_arg, "collect DIR");
   for (const std::string& s : shards)
-    if (!fs::exists(s + "/grid.json")) throw UsageError("'" + s + "' is not a sweep folder (no grid.json)");
+    if (!fs::exists(s + "/grid.json"))
+      throw UsageError("'" + rig::ClipForMessage(s) + "' is not a sweep folder (no grid.json)");
+  for (const std::string& s : shards)
+    if (ReadFile(s + "/grid.json") != ReadFile(shards[0] + "/grid.json"))
+      throw UsageError("'" + rig::ClipForMessage(s) + "' holds a different sweep than '" +
+                       rig::ClipForMessage(shards[0]) + "' (grid.json differs)");
   if (!fs::exists(dir + "/grid.json")) {
-    if (shards.empty()) throw UsageError("'" + dir + "' is not a sweep folder (no grid.json)");
+    if (shards.empty()) throw UsageError("'" + rig::ClipForMessage(dir) + "' is not a sweep folder (no grid.json)");
+    // Merging into a new or empty folder only: never into one that holds
+    // something else.
+    CheckOutputTarget(dir, "collect DIR", ExistingOutput::kRefuse);
     EnsureDirectory(dir + "/runs");
     WriteTextAtomic(dir + "/grid.json", ReadFile(shards[0] + "/grid.json"));
     if (fs::exists(shards[0] + "/sweep.yaml")) WriteTextAtomic(dir + "/sweep.yaml", ReadFile(shards[0] + "/sweep.yaml"));
@@ -250,6 +335,8 @@ void AddSweepCommands(CLI::App& app, std::function<int()>* run) {
       ->check(CLI::Range(0, 1024));
   cmd->add_option("--shard", args->shard, "I/N: run only the I-th of N slices of the grid");
   cmd->add_flag("--no-report", args->no_report, "skip report.html");
+  cmd->add_flag("--resume", args->resume,
+                "continue the same sweep in --out: skip finished runs, redo half-built ones");
   cmd->callback([args, run] { *run = [args] { return RunSweep(*args); }; });
 
   auto dir = std::make_shared<std::string>();

@@ -8,6 +8,8 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <optional>
+#include <set>
 #include <sstream>
 
 #include "output.h"
@@ -32,35 +34,30 @@ std::string Range(const ConfigParam& p) {
   return "[" + FormatNumber(p.lo) + ", " + FormatNumber(p.hi) + "]";
 }
 
-// Parses `text` as a whole number of the given kind, or fails.
-bool ParseDouble(const std::string& text, double* v) {
-  const char* b = text.data();
-  const auto r = std::from_chars(b, b + text.size(), *v);
-  return r.ec == std::errc() && r.ptr == b + text.size() && std::isfinite(*v);
-}
-
-void Assign(const ConfigParam& p, const std::string& text, const std::string& where) {
-  auto fail = [&](const std::string& why) { throw UsageError(where + "key '" + p.path + "': " + why); };
+// `label` names the parameter in messages: "key 'idr.sigma'" or "--sigma".
+void Assign(const ConfigParam& p, const std::string& text, const std::string& label) {
+  auto fail = [&](const std::string& why) { throw UsageError(label + ": " + why); };
+  const std::string shown = "'" + rig::ClipForMessage(text) + "'";
   if (auto* b = std::get_if<bool*>(&p.target)) {
     if (text == "true") **b = true;
     else if (text == "false") **b = false;
-    else fail("expected true or false, got '" + text + "'");
+    else fail("expected true or false, got " + shown);
     return;
   }
   if (auto* s = std::get_if<std::string*>(&p.target)) {
     if (!p.choices.empty() && std::find(p.choices.begin(), p.choices.end(), text) == p.choices.end())
-      fail("'" + text + "' is not " + Range(p));
+      fail(shown + " is not " + Range(p));
     **s = text;
     return;
   }
-  double v;
-  if (!ParseDouble(text, &v)) fail("expected a number, got '" + text + "'");
+  const std::optional<double> v = ParseNumber(text);
+  if (!v) fail("expected a number, got " + shown);
   const bool integral = !std::holds_alternative<double*>(p.target);
-  if (integral && v != std::floor(v)) fail("expected a whole number, got '" + text + "'");
-  if (v < p.lo || v > p.hi) fail(text + " is out of range " + Range(p));
-  if (auto* d = std::get_if<double*>(&p.target)) **d = v;
-  else if (auto* i = std::get_if<int*>(&p.target)) **i = static_cast<int>(v);
-  else if (auto* u = std::get_if<uint64_t*>(&p.target)) **u = static_cast<uint64_t>(v);
+  if (integral && *v != std::floor(*v)) fail("expected a whole number, got " + shown);
+  if (*v < p.lo || *v > p.hi) fail(rig::ClipForMessage(text) + " is out of range " + Range(p));
+  if (auto* d = std::get_if<double*>(&p.target)) **d = *v;
+  else if (auto* i = std::get_if<int*>(&p.target)) **i = static_cast<int>(*v);
+  else if (auto* u = std::get_if<uint64_t*>(&p.target)) **u = static_cast<uint64_t>(*v);
 }
 
 std::string ValueText(const ConfigParam& p) {
@@ -71,7 +68,30 @@ std::string ValueText(const ConfigParam& p) {
   return std::to_string(**std::get_if<uint64_t*>(&p.target));
 }
 
+// The value as YAML text that reads back the same: a string stays plain
+// only where YAML reads it back unchanged as a value (no '#', ': ', newline,
+// leading space, null word); else it is double-quoted with escapes.
+std::string YamlValueText(const ConfigParam& p) {
+  auto* s = std::get_if<std::string*>(&p.target);
+  if (!s) return ValueText(p);
+  YAML::Emitter plain;
+  plain << **s;
+  static const std::set<std::string> kNullWords = {"", "~", "null", "Null", "NULL"};
+  if (plain.c_str() == **s && !kNullWords.count(**s)) return **s;
+  YAML::Emitter quoted;
+  quoted << YAML::DoubleQuoted << **s;
+  return quoted.c_str();
+}
+
 }  // namespace
+
+std::optional<double> ParseNumber(const std::string& text) {
+  double v = 0;
+  const char* b = text.data();
+  const auto r = std::from_chars(b, b + text.size(), v);
+  if (r.ec != std::errc() || r.ptr != b + text.size() || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
 
 std::vector<ConfigParam> ConfigParams(RunConfig* c) {
   fovea::FoveaOptions& f = c->fovea;
@@ -156,8 +176,27 @@ std::vector<ConfigParam> ConfigParams(RunConfig* c) {
 
 void SetParam(RunConfig* config, const std::string& path, const std::string& value) {
   for (const ConfigParam& p : ConfigParams(config))
-    if (p.path == path) return Assign(p, value, "");
-  throw UsageError("unknown key '" + path + "'");
+    if (p.path == path) return Assign(p, value, "key '" + path + "'");
+  throw UsageError("unknown key '" + rig::ClipForMessage(path) + "'");
+}
+
+void SetParamFromFlag(RunConfig* config, const std::string& flag, const std::string& path, const std::string& value) {
+  for (const ConfigParam& p : ConfigParams(config))
+    if (p.path == path) return Assign(p, value, flag + " (" + path + ")");
+  throw std::logic_error("flag " + flag + " names no parameter '" + path + "'");
+}
+
+CLI::Validator NumberIn(double lo, double hi, bool whole) {
+  return CLI::Validator(
+      [lo, hi, whole](std::string& text) -> std::string {
+        const std::string shown = "'" + rig::ClipForMessage(text) + "'";
+        const std::optional<double> v = ParseNumber(text);
+        if (!v) return "expected a number, got " + shown;
+        if (whole && *v != std::floor(*v)) return "expected a whole number, got " + shown;
+        if (*v < lo || *v > hi) return shown + " is out of range [" + FormatNumber(lo) + ", " + FormatNumber(hi) + "]";
+        return "";
+      },
+      "NUMBER in [" + FormatNumber(lo) + ", " + FormatNumber(hi) + "]");
 }
 
 namespace {
@@ -171,31 +210,65 @@ void Walk(const YAML::Node& node, const std::string& prefix, std::map<std::strin
       if (it != params.end()) throw UsageError(where + "key '" + path + "': expected a value, got a mapping");
       bool known_section = false;
       for (const auto& [name, p] : params) known_section |= name.rfind(path + ".", 0) == 0;
-      if (!known_section) throw UsageError(where + "unknown key '" + path + "'");
+      if (!known_section) throw UsageError(where + "unknown key '" + rig::ClipForMessage(path) + "'");
       Walk(kv.second, path, params, where);
       continue;
     }
-    if (it == params.end()) throw UsageError(where + "unknown key '" + path + "'");
+    if (it == params.end()) throw UsageError(where + "unknown key '" + rig::ClipForMessage(path) + "'");
     if (!kv.second.IsScalar()) throw UsageError(where + "key '" + path + "': expected a single value");
-    Assign(*it->second, kv.second.Scalar(), where);
+    Assign(*it->second, kv.second.Scalar(), where + "key '" + path + "'");
   }
 }
 }  // namespace
 
-YAML::Node LoadYamlFile(const std::string& path, const std::string& where) {
-  std::ifstream in(path);
-  if (!in) throw UsageError(where + "cannot read the file");
-  std::stringstream text;
-  text << in.rdbuf();
-  try {
-    return YAML::Load(text.str());
-  } catch (const YAML::Exception& e) {
-    throw UsageError(where + "not valid YAML (line " + std::to_string(e.mark.line + 1) + ": " + e.msg + ")");
+namespace {
+// yaml-cpp keeps a mapping's repeated keys (the last wins on lookup) and lets
+// aliases share nodes: refuse the first, and bound the walk for the second.
+void CheckYamlTree(const YAML::Node& node, const std::string& where, long* budget) {
+  constexpr long kMaxNodes = 1000000;
+  if (++*budget > kMaxNodes) throw UsageError(where + "more than " + std::to_string(kMaxNodes) + " values");
+  if (node.IsMap()) {
+    std::set<std::string> keys;
+    for (const auto& kv : node) {
+      if (!kv.first.IsScalar()) throw UsageError(where + "a key that is not a single value");
+      if (!keys.insert(kv.first.Scalar()).second)
+        throw UsageError(where + "key '" + rig::ClipForMessage(kv.first.Scalar()) + "' appears twice");
+      CheckYamlTree(kv.second, where, budget);
+    }
+  } else if (node.IsSequence()) {
+    for (const auto& item : node) CheckYamlTree(item, where, budget);
   }
+}
+}  // namespace
+
+YAML::Node ParseYaml(const std::string& text, const std::string& where) {
+  std::vector<YAML::Node> docs;
+  try {
+    docs = YAML::LoadAll(text);
+  } catch (const YAML::Exception& e) {
+    throw UsageError(where + "not valid YAML (line " + std::to_string(e.mark.line + 1) + ": " +
+                     rig::ClipForMessage(e.msg) + ")");
+  }
+  if (docs.size() > 1)
+    throw UsageError(where + "holds " + std::to_string(docs.size()) + " YAML documents; expected one");
+  const YAML::Node root = docs.empty() ? YAML::Node() : docs[0];
+  long budget = 0;
+  CheckYamlTree(root, where, &budget);
+  return root;
+}
+
+YAML::Node LoadYamlFile(const std::string& path, const std::string& where) {
+  std::string text;
+  try {
+    text = rig::ReadInputFile(path, "file");
+  } catch (const rig::InputError& e) {
+    throw UsageError(where + e.what());
+  }
+  return ParseYaml(text, where);
 }
 
 RunConfig LoadConfig(const std::string& path) {
-  const std::string where = "config " + path + ": ";
+  const std::string where = "config " + rig::ClipForMessage(path) + ": ";
   const YAML::Node root = LoadYamlFile(path, where);
   RunConfig config;
   ApplyYaml(root, &config, where);
@@ -253,25 +326,40 @@ void RunConfig::Check() const {
                      " is wider than the carriages allow (2 x rig.carriage_max_m = " + FormatNumber(widest) + ")");
 }
 
+std::vector<std::string> SplitFields(const std::string& text) {
+  std::vector<std::string> fields;
+  size_t start = 0;
+  for (size_t comma; (comma = text.find(',', start)) != std::string::npos; start = comma + 1)
+    fields.push_back(text.substr(start, comma - start));
+  fields.push_back(text.substr(start));
+  return fields;
+}
+
 std::array<int, 6> SixInts(const std::string& text, const std::string& key) {
+  const std::vector<std::string> fields = SplitFields(text);
   std::array<int, 6> v{};
-  std::stringstream ss(text);
-  std::string item;
-  int n = 0;
-  while (std::getline(ss, item, ',')) {
-    double x;
-    if (n == 6 || !ParseDouble(item, &x) || x != std::floor(x))
-      throw UsageError("key '" + key + "': expected six whole numbers separated by commas, got '" + text + "'");
-    v[n++] = static_cast<int>(x);
+  bool ok = fields.size() == v.size();
+  for (size_t i = 0; ok && i < v.size(); ++i) {
+    const std::optional<double> x = ParseNumber(fields[i]);
+    ok = x && *x == std::floor(*x) && std::abs(*x) <= 1e6;
+    v[i] = ok ? static_cast<int>(*x) : 0;
   }
-  if (n != 6) throw UsageError("key '" + key + "': expected six whole numbers separated by commas, got '" + text + "'");
+  if (!ok)
+    throw UsageError("key '" + key + "': expected six whole numbers separated by commas, got '" +
+                     rig::ClipForMessage(text) + "'");
   return v;
 }
 
-std::string CanonicalConfig(const RunConfig& const_config) {
+std::vector<std::pair<std::string, std::string>> ParamValues(const RunConfig& const_config) {
   RunConfig config = const_config;
+  std::vector<std::pair<std::string, std::string>> values;
+  for (const ConfigParam& p : ConfigParams(&config)) values.emplace_back(p.path, ValueText(p));
+  return values;
+}
+
+std::string CanonicalConfig(const RunConfig& config) {
   std::string text;
-  for (const ConfigParam& p : ConfigParams(&config)) text += p.path + "=" + ValueText(p) + "\n";
+  for (const auto& [path, value] : ParamValues(config)) text += path + "=" + value + "\n";
   return text;
 }
 
@@ -306,7 +394,7 @@ std::string DumpConfig(const RunConfig& const_config) {
       section = sec;
     }
     const std::string indent = sec.empty() ? "" : "  ";
-    out << indent << key << ": " << ValueText(p) << "  # " << p.doc << "; " << Range(p) << "\n";
+    out << indent << key << ": " << YamlValueText(p) << "  # " << p.doc << "; " << Range(p) << "\n";
   }
   return out.str();
 }

@@ -3,8 +3,10 @@
 // work starts, and written back out in full beside the results.
 #pragma once
 
+#include <CLI/CLI.hpp>
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <variant>
 #include <yaml-cpp/node/node.h>
@@ -76,9 +78,29 @@ RunConfig LoadConfig(const std::string& path);
 /// UsageError like LoadConfig.
 void SetParam(RunConfig* config, const std::string& path, const std::string& value);
 
+/// The same for a command-line flag that sets parameter `path`: the flag's
+/// value is checked against the table like a YAML value, and a message names
+/// the flag ("--sigma (idr.log_sigma_px): 0 is out of range [1, 8]").
+void SetParamFromFlag(RunConfig* config, const std::string& flag, const std::string& path, const std::string& value);
+
+/// The one number parser of flags and YAML values: a finite decimal number
+/// ("3", "-0.5", "2e-3") and nothing else (no NaN, infinity, hex, spaces or
+/// trailing characters).
+std::optional<double> ParseNumber(const std::string& text);
+
+/// The comma-separated fields of `text`, empty ones included ("a,,b" has 3).
+std::vector<std::string> SplitFields(const std::string& text);
+
+/// A CLI11 check for a flag that is not a parameter: ParseNumber, within
+/// [lo, hi], whole if `whole`.
+CLI::Validator NumberIn(double lo, double hi, bool whole = false);
+
 /// The full effective configuration as YAML, each key with its meaning and
 /// range as a comment.
 std::string DumpConfig(const RunConfig& config);
+
+/// Every parameter's path and value as text (as ParamText), in table order.
+std::vector<std::pair<std::string, std::string>> ParamValues(const RunConfig& config);
 
 /// Every parameter as "path=value" lines in table order: the canonical text
 /// that names a run (see ConfigHash).
@@ -91,9 +113,14 @@ std::string ConfigHash(const RunConfig& config);
 /// The value of one parameter as text (as written in the YAML file).
 std::string ParamText(RunConfig* config, const std::string& path);
 
-/// Parses a YAML file; throws UsageError prefixed with `where` when it cannot
-/// be read or is not YAML (with the line).
+/// Parses a YAML file (rig::ReadInputFile: a regular file of at most 64 MiB);
+/// throws UsageError prefixed with `where` when it cannot be read, is not
+/// YAML (with the line), holds more than one document, repeats a key in a
+/// mapping, or holds more than a million values.
 YAML::Node LoadYamlFile(const std::string& path, const std::string& where);
+
+/// The same for YAML text.
+YAML::Node ParseYaml(const std::string& text, const std::string& where);
 
 /// Reads the keys of a YAML mapping over `config` (as LoadConfig does for a
 /// file); `where` prefixes every error message.

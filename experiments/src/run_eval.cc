@@ -162,6 +162,7 @@ MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref, const si
     SurfaceFigures sf;
     sf.name = truth.GeomName(geom);
     sf.pixels = ps.pixels;
+    sf.mapped = ps.mapped;
     sf.coverage = double(ps.mapped) / ps.pixels;
     sf.foveal_coverage = double(ps.foveal) / ps.pixels;
     sf.stereo_visible_share = double(ps.stereo_visible) / ps.pixels;
@@ -192,30 +193,34 @@ MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref, const si
 }
 
 namespace {
+// A figure over `pixels` values: null when there were none.
+nlohmann::json Figure(long pixels, double value) { return pixels > 0 ? nlohmann::json(value) : nlohmann::json(); }
+
 nlohmann::json ErrorJson(const ErrorFigures& f) {
   return {{"pixels", f.pixels},
           {"share", f.share},
-          {"median_abs_error_m", f.median_abs_error_m},
-          {"mean_abs_error_m", f.mean_abs_error_m},
-          {"rmse_m", f.rmse_m},
-          {"median_rel_error", f.median_rel_error},
-          {"within_1pct", f.within_1pct},
-          {"median_error_steps", f.median_error_steps}};
+          {"median_abs_error_m", Figure(f.pixels, f.median_abs_error_m)},
+          {"mean_abs_error_m", Figure(f.pixels, f.mean_abs_error_m)},
+          {"rmse_m", Figure(f.pixels, f.rmse_m)},
+          {"median_rel_error", Figure(f.pixels, f.median_rel_error)},
+          {"within_1pct", Figure(f.pixels, f.within_1pct)},
+          {"median_error_steps", Figure(f.pixels, f.median_error_steps)}};
 }
 }  // namespace
 
 nlohmann::json ScoreJson(const MapScore& s) {
+  const long n = s.overall.pixels;
   nlohmann::json j;
   j["coverage"] = s.coverage;
   j["foveal_coverage"] = s.foveal_coverage;
   j["stereo_visible_share"] = s.stereo_visible_share;
   j["stereo_visible_coverage"] = s.stereo_visible_coverage;
-  j["median_abs_error_m"] = s.overall.median_abs_error_m;
-  j["median_rel_error"] = s.overall.median_rel_error;
-  j["rmse_m"] = s.overall.rmse_m;
-  j["mean_abs_error_m"] = s.overall.mean_abs_error_m;
-  j["within_1pct"] = s.overall.within_1pct;
-  j["median_error_steps"] = s.overall.median_error_steps;
+  j["median_abs_error_m"] = Figure(n, s.overall.median_abs_error_m);
+  j["median_rel_error"] = Figure(n, s.overall.median_rel_error);
+  j["rmse_m"] = Figure(n, s.overall.rmse_m);
+  j["mean_abs_error_m"] = Figure(n, s.overall.mean_abs_error_m);
+  j["within_1pct"] = Figure(n, s.overall.within_1pct);
+  j["median_error_steps"] = Figure(n, s.overall.median_error_steps);
   for (int i = 0; i < 3; ++i)
     j["by_level"][fovea::PatchLevelName(static_cast<fovea::PatchLevel>(i))] = ErrorJson(s.by_level[i]);
   for (const SurfaceFigures& sf : s.surfaces)
@@ -223,15 +228,32 @@ nlohmann::json ScoreJson(const MapScore& s) {
                                 {"coverage", sf.coverage},
                                 {"foveal_coverage", sf.foveal_coverage},
                                 {"stereo_visible_share", sf.stereo_visible_share},
-                                {"median_abs_error_m", sf.median_abs_error_m},
-                                {"median_rel_error", sf.median_rel_error},
-                                {"median_error_steps", sf.median_error_steps},
-                                {"rmse_m", sf.rmse_m}};
+                                {"median_abs_error_m", Figure(sf.mapped, sf.median_abs_error_m)},
+                                {"median_rel_error", Figure(sf.mapped, sf.median_rel_error)},
+                                {"median_error_steps", Figure(sf.mapped, sf.median_error_steps)},
+                                {"rmse_m", Figure(sf.mapped, sf.rmse_m)}};
   if (s.has_patch_error)
     j["patch_3d_error"] = {{"patches", s.patches_scored},
-                           {"median_m", s.patch_error_median_m},
-                           {"p90_m", s.patch_error_p90_m}};
+                           {"median_m", Figure(s.patches_scored, s.patch_error_median_m)},
+                           {"p90_m", Figure(s.patches_scored, s.patch_error_p90_m)}};
   return j;
+}
+
+std::string ScoreLine(const MapScore& s, bool brief) {
+  char line[256];
+  const ErrorFigures& e = s.overall;
+  if (e.pixels == 0) {
+    std::snprintf(line, sizeof line, "coverage %.3f, foveal %.3f, median error - (no mapped pixel)", s.coverage,
+                  s.foveal_coverage);
+  } else if (brief) {
+    std::snprintf(line, sizeof line, "coverage %.3f, foveal %.3f, median error %.2f mm", s.coverage,
+                  s.foveal_coverage, 1e3 * e.median_abs_error_m);
+  } else {
+    std::snprintf(line, sizeof line, "coverage %.3f, foveal %.3f, median error %.2f mm (%.3f%% of depth), RMSE %.2f mm",
+                  s.coverage, s.foveal_coverage, 1e3 * e.median_abs_error_m, 100 * e.median_rel_error,
+                  1e3 * e.rmse_m);
+  }
+  return line;
 }
 
 }  // namespace experiments

@@ -53,6 +53,7 @@ struct SurfaceFigures {
   double coverage = 0, foveal_coverage = 0;
   double stereo_visible_share = 0;  ///< of its pixels, those in ReferenceView::stereo_visible
   double median_abs_error_m = 0, median_rel_error = 0, median_error_steps = 0, rmse_m = 0;  ///< 0 when unmapped
+  long mapped = 0;                 ///< of its pixels, those with an estimate
 };
 
 struct MapScore {
@@ -74,6 +75,13 @@ struct MapScore {
 MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref, const sim::GroundTruth& truth,
                   double baseline_m, bool per_patch);
 
+/// The figures as summary.json holds them. Error figures over no pixel (an
+/// empty map, an unmapped level or surface) are null, not zero.
 nlohmann::json ScoreJson(const MapScore& score);
+
+/// The score in one line for messages and captions: "coverage 0.998, foveal
+/// 0.284, median error 2.08 mm (0.230% of depth), RMSE 11.58 mm" ("median
+/// error -" for an empty map); `brief`: coverage, foveal and median error.
+std::string ScoreLine(const MapScore& score, bool brief = false);
 
 }  // namespace experiments

@@ -1,7 +1,6 @@
 #include "scene_options.h"
 
 #include <cmath>
-#include <sstream>
 
 #include "output.h"
 #include "scenes/catalog.h"
@@ -11,48 +10,50 @@ namespace experiments {
 void SceneOptions::Register(CLI::App* cmd, bool with_state) {
   cmd->add_option("--scene", scene, "catalog scene name or path to an MJCF file")
       ->default_str(scenes::kDefaultScene);
-  cmd->add_option("--noise", noise_sigma_dn, "sensor read noise, grey levels (0 = off)")
-      ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--seed", seed, "seed of the sensor noise");
+  cmd->add_option("--noise", noise, "sensor read noise, grey levels (0 = off; rig.noise_sigma_dn)");
+  cmd->add_option("--seed", seed, "seed of the sensor noise (and of every draw)");
   if (with_state) {
     auto* s = cmd->add_option("--state", state,
                               "stage state: left baseline m, left pan deg, left tilt deg, right "
                               "baseline m, right pan deg, right tilt deg (comma separated)");
-    auto* b = cmd->add_option("--baseline", baseline_m,
-                              "parallel, level cameras this far apart (metres)");
+    auto* b = cmd->add_option("--baseline", baseline, "parallel, level cameras this far apart (metres)")
+                  ->check(NumberIn(1e-4, 10));
     s->excludes(b);
   }
 }
 
-rig::StageState SceneOptions::TargetState(const rig::StageState& home) const {
-  if (baseline_m) return rig::StageState::Parallel(*baseline_m);
-  if (state.empty()) return home;
+void SceneOptions::ApplyTo(RunConfig* config) const {
+  if (!scene.empty()) SetParamFromFlag(config, "--scene", "scene", scene);
+  if (!noise.empty()) SetParamFromFlag(config, "--noise", "rig.noise_sigma_dn", noise);
+  if (!seed.empty()) SetParamFromFlag(config, "--seed", "seed", seed);
+}
+
+std::optional<rig::StageState> SceneOptions::TargetState() const {
+  if (!baseline.empty()) return rig::StageState::Parallel(*ParseNumber(baseline));
+  if (state.empty()) return std::nullopt;
+  const std::vector<std::string> fields = SplitFields(state);
+  if (fields.size() != rig::kNumAxes)
+    throw UsageError("--state needs exactly 6 comma-separated numbers, got '" + rig::ClipForMessage(state) + "'");
   std::array<double, rig::kNumAxes> v{};
-  std::stringstream in(state);
-  std::string field;
-  int n = 0;
-  while (std::getline(in, field, ',')) {
-    if (n >= rig::kNumAxes) break;
-    try {
-      size_t used = 0;
-      v[n] = std::stod(field, &used);
-      if (used != field.size() || !std::isfinite(v[n])) throw std::invalid_argument(field);
-    } catch (const std::exception&) {
-      throw UsageError("--state: '" + field + "' is not a number");
-    }
-    ++n;
+  for (int i = 0; i < rig::kNumAxes; ++i) {
+    const std::optional<double> x = ParseNumber(fields[i]);
+    if (!x) throw UsageError("--state: '" + rig::ClipForMessage(fields[i]) + "' is not a number");
+    v[i] = *x;
   }
-  if (n != rig::kNumAxes || in.good())
-    throw UsageError("--state needs exactly 6 comma-separated numbers, got '" + state + "'");
   for (int i : {1, 2, 4, 5}) v[i] *= M_PI / 180;  // degrees on the command line
   return rig::StageState::FromArray(v);
 }
 
-std::unique_ptr<sim::Simulation> SceneOptions::Load() const {
-  sim::SimRigConfig config;
-  config.noise.read_noise_sigma_dn = noise_sigma_dn;
-  config.seed = seed;
-  return scenes::LoadScene(scene.empty() ? scenes::kDefaultScene : scene, config);
+std::unique_ptr<sim::Simulation> LoadSceneOf(const RunConfig& config) {
+  sim::SimRigConfig rig = config.rig;
+  rig.seed = config.seed;
+  return scenes::LoadScene(config.scene.empty() ? scenes::kDefaultScene : config.scene, rig);
 }
+
+void AddForceFlag(CLI::App* cmd, bool* force) {
+  cmd->add_flag("--force", *force, "replace an earlier result of fovea at --out (never anything else)");
+}
+
+ExistingOutput ExistingPolicy(bool force) { return force ? ExistingOutput::kReplace : ExistingOutput::kRefuse; }
 
 }  // namespace experiments

@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <optional>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -17,7 +18,7 @@ namespace experiments {
 namespace fs = std::filesystem;
 namespace {
 
-constexpr int kMaxRuns = 100000;
+
 
 std::string Number(double v) {
   char buf[40];
@@ -39,10 +40,9 @@ std::vector<std::string> AxisValues(const YAML::Node& node, const std::string& w
       const std::string key = kv.first.as<std::string>();
       if (key != "from" && key != "to" && key != "step" && key != "count")
         throw UsageError(where + "unknown range key '" + key + "' (expected from, to, step or count)");
-      double v;
-      if (!kv.second.IsScalar() || !YAML::convert<double>::decode(kv.second, v) || !std::isfinite(v))
-        throw UsageError(where + "range key '" + key + "': expected a number");
-      r[key] = v;
+      const std::optional<double> v = kv.second.IsScalar() ? ParseNumber(kv.second.Scalar()) : std::nullopt;
+      if (!v) throw UsageError(where + "range key '" + key + "': expected a number");
+      r[key] = *v;
     }
     if (!r.count("from") || !r.count("to")) throw UsageError(where + "a range needs from and to");
     if (r.count("step") == r.count("count")) throw UsageError(where + "a range needs exactly one of step or count");
@@ -50,8 +50,8 @@ std::vector<std::string> AxisValues(const YAML::Node& node, const std::string& w
     int n;
     double step;
     if (r.count("count")) {
-      if (!(r["count"] >= 1 && r["count"] <= kMaxRuns && r["count"] == std::floor(r["count"])))
-        throw UsageError(where + "range count must be a whole number from 1 to " + std::to_string(kMaxRuns));
+      if (!(r["count"] >= 1 && r["count"] <= kMaxSweepRuns && r["count"] == std::floor(r["count"])))
+        throw UsageError(where + "range count must be a whole number from 1 to " + std::to_string(kMaxSweepRuns));
       n = static_cast<int>(r["count"]);
       step = n > 1 ? (to - from) / (n - 1) : 0;
     } else {
@@ -59,7 +59,7 @@ std::vector<std::string> AxisValues(const YAML::Node& node, const std::string& w
       if (!(step > 0)) throw UsageError(where + "range step must be positive");
       if (to < from) throw UsageError(where + "range needs from <= to");
       const double k = std::floor((to - from) / step + 1e-9);
-      if (k + 1 > kMaxRuns) throw UsageError(where + "range has more than " + std::to_string(kMaxRuns) + " values");
+      if (k + 1 > kMaxSweepRuns) throw UsageError(where + "range has more than " + std::to_string(kMaxSweepRuns) + " values");
       n = static_cast<int>(k) + 1;
     }
     for (int i = 0; i < n; ++i) values.push_back(Number(from + i * step));
@@ -97,7 +97,7 @@ bool ConcernsStatic(const std::string& path) {
 }  // namespace
 
 Sweep LoadSweep(const std::string& path) {
-  const std::string where = "sweep " + path + ": ";
+  const std::string where = "sweep " + rig::ClipForMessage(path) + ": ";
   const YAML::Node root = LoadYamlFile(path, where);
   if (!root.IsMap()) throw UsageError(where + "expected a mapping with base, config, axes, baselines, jobs");
   Sweep sweep;
@@ -106,7 +106,8 @@ Sweep LoadSweep(const std::string& path) {
   for (const auto& kv : root) {
     const std::string key = kv.first.as<std::string>();
     if (key != "base" && key != "config" && key != "axes" && key != "baselines" && key != "jobs")
-      throw UsageError(where + "unknown key '" + key + "' (expected base, config, axes, baselines, jobs)");
+      throw UsageError(where + "unknown key '" + rig::ClipForMessage(key) +
+                       "' (expected base, config, axes, baselines, jobs)");
   }
   if (root["base"]) {
     if (!root["base"].IsScalar()) throw UsageError(where + "key 'base': expected a file name");
@@ -119,10 +120,10 @@ Sweep LoadSweep(const std::string& path) {
     ApplyYaml(root["config"], &base, where + "config: ");
   }
   if (root["jobs"]) {
-    int jobs = -1;
-    if (!root["jobs"].IsScalar() || !YAML::convert<int>::decode(root["jobs"], jobs) || jobs < 0 || jobs > 1024)
+    const std::optional<double> jobs = root["jobs"].IsScalar() ? ParseNumber(root["jobs"].Scalar()) : std::nullopt;
+    if (!jobs || *jobs != std::floor(*jobs) || *jobs < 0 || *jobs > 1024)
       throw UsageError(where + "key 'jobs': expected a whole number in [0, 1024] (0 = every core)");
-    sweep.jobs = jobs;
+    sweep.jobs = static_cast<int>(*jobs);
   }
   if (!root["axes"] || !root["axes"].IsMap() || root["axes"].size() == 0)
     throw UsageError(where + "key 'axes': expected a mapping of parameter paths to values");
@@ -135,7 +136,7 @@ Sweep LoadSweep(const std::string& path) {
       try {
         ParamText(&probe, axis.path);
       } catch (const UsageError&) {
-        throw UsageError(where + "axes: unknown key '" + axis.path + "'");
+        throw UsageError(where + "axes: unknown key '" + rig::ClipForMessage(axis.path) + "'");
       }
     }
     axis.values = AxisValues(kv.second, at);
@@ -157,7 +158,8 @@ Sweep LoadSweep(const std::string& path) {
     for (const auto& b : root["baselines"]) {
       const std::string name = b.IsScalar() ? b.Scalar() : "";
       if (name != "deterministic" && name != "static_sgbm")
-        throw UsageError(where + "key 'baselines': '" + name + "' is not one of deterministic, static_sgbm");
+        throw UsageError(where + "key 'baselines': '" + rig::ClipForMessage(name) +
+                         "' is not one of deterministic, static_sgbm");
       sweep.baselines.push_back(name);
     }
   }
@@ -166,7 +168,9 @@ Sweep LoadSweep(const std::string& path) {
   long total = 1;
   for (const SweepAxis& a : sweep.axes) {
     total *= static_cast<long>(a.values.size());
-    if (total > kMaxRuns) throw UsageError(where + "the grid has more than " + std::to_string(kMaxRuns) + " runs");
+    if (total * static_cast<long>(1 + sweep.baselines.size()) > kMaxSweepRuns)
+      throw UsageError(where + "the grid has more than " + std::to_string(kMaxSweepRuns) +
+                       " runs (the limit of one sweep; split it into several)");
   }
   std::set<std::string> seen;
   auto add = [&](const RunConfig& c, const std::vector<std::pair<std::string, std::string>>& point) {
@@ -227,9 +231,8 @@ nlohmann::json GridJson(const Sweep& sweep) {
     run["variant"] = r.variant;
     run["point"] = nlohmann::json::object();
     for (const auto& [p, v] : r.point) run["point"][p] = v;
-    RunConfig c = r.config;
     nlohmann::json params = nlohmann::json::array();
-    for (const ConfigParam& p : ConfigParams(&c)) params.push_back({p.path, ParamText(&c, p.path)});
+    for (const auto& [path, value] : ParamValues(r.config)) params.push_back({path, value});
     run["config"] = params;
     j["runs"].push_back(run);
   }

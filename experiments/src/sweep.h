@@ -34,6 +34,10 @@ struct Sweep {
   std::vector<SweepRun> runs;  ///< grid order (last axis fastest), then baselines; no two alike
 };
 
+/// The most runs one sweep may hold, baselines included: a grid past it is
+/// refused (split it). Setting it up takes about a second per thousand runs.
+constexpr long kMaxSweepRuns = 10000;
+
 /// Reads and checks a sweep file: every run's configuration is built and
 /// checked, so nothing starts unless all are valid. Throws UsageError
 /// ("sweep FILE: ...") naming the key.

@@ -1,5 +1,9 @@
 #include "rig/hardware_rig.h"
 
+#include <cmath>
+
+#include "rig/input_file.h"
+
 #include <filesystem>
 #include <algorithm>
 #include <future>
@@ -80,7 +84,7 @@ void ReadCamera(const cv::FileStorage& fs, const std::string& path, const char* 
                 Eigen::Vector3d* offset) {
   const cv::FileNode n = fs[name];
   auto fail = [&](const std::string& what) {
-    throw RigError("calibration " + path + ": " + name + ": " + what);
+    throw InputError("calibration " + ClipForMessage(path) + ": " + name + ": " + what);
   };
   if (n.empty() || !n.isMap()) fail("missing");
   for (const char* key : {"width_px", "height_px", "fx_px", "fy_px", "cx_px", "cy_px"})
@@ -97,6 +101,9 @@ void ReadCamera(const cv::FileStorage& fs, const std::string& path, const char* 
   if (!n["optical_centre_H_m"].empty()) n["optical_centre_H_m"] >> o;
   if (!o.empty() && o.size() != 3) fail("optical_centre_H_m needs 3 numbers");
   *offset = o.empty() ? Eigen::Vector3d::Zero() : Eigen::Vector3d(o[0], o[1], o[2]);
+  if (!offset->allFinite()) fail("optical_centre_H_m holds a non-finite number");
+  for (const double d : k->distortion)
+    if (!std::isfinite(d)) fail("distortion holds a non-finite number");
   try {
     k->Check();
   } catch (const RigError& e) {
@@ -107,13 +114,13 @@ void ReadCamera(const cv::FileStorage& fs, const std::string& path, const char* 
 }  // namespace
 
 RigCalibration LoadCalibration(const std::string& path) {
-  if (::access(path.c_str(), R_OK) != 0) throw RigError("calibration " + path + ": cannot be read");
+  const std::string text = ReadInputFile(path, "calibration");
   cv::FileStorage fs;
   try {
-    fs.open(path, cv::FileStorage::READ);
+    fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY);
   } catch (const cv::Exception&) {
   }
-  if (!fs.isOpened()) throw RigError("calibration " + path + ": cannot be read");
+  if (!fs.isOpened()) throw InputError("calibration '" + ClipForMessage(path) + "' cannot be read (not OpenCV YAML)");
   RigCalibration c;
   ReadCamera(fs, path, "left", &c.left, &c.left_optical_centre_H);
   ReadCamera(fs, path, "right", &c.right, &c.right_optical_centre_H);

@@ -4,6 +4,7 @@
 #include <poll.h>
 #include <pty.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -12,6 +13,8 @@
 #include <cstring>
 #include <libserial/SerialPort.h>
 #include <thread>
+
+#include "rig/input_file.h"
 
 namespace rig {
 namespace {
@@ -75,7 +78,8 @@ class LibSerialLine : public SerialLine {
       port_.SetStopBits(LibSerial::StopBits::STOP_BITS_1);
       port_.SetFlowControl(LibSerial::FlowControl::FLOW_CONTROL_NONE);
     } catch (const std::exception& e) {
-      throw RigError("serial port '" + port + "' cannot be opened: " + e.what());
+      CloseQuietly();  // LibSerial's own destructor would throw from here
+      throw RigError("serial port '" + ClipForMessage(port) + "' cannot be opened: " + e.what());
     }
     name_ = port;
   }
@@ -100,10 +104,13 @@ class LibSerialLine : public SerialLine {
     return n > 0 ? std::string(buf, static_cast<size_t>(n)) : "";
   }
   int NativeHandle() const override { return port_.GetFileDescriptor(); }
-  ~LibSerialLine() override {
-    // LibSerial's Close restores the port's settings and throws when the
-    // line is gone (EIO), leaving the port open, and its destructor would
-    // then throw again.
+  ~LibSerialLine() override { CloseQuietly(); }
+
+ private:
+  // LibSerial's Close restores the port's settings and throws when the line
+  // is gone (EIO) or is no terminal, leaving the port open, and its
+  // destructor would then throw again (std::terminate).
+  void CloseQuietly() noexcept {
     try {
       if (port_.IsOpen()) port_.Close();
     } catch (...) {
@@ -126,7 +133,6 @@ class LibSerialLine : public SerialLine {
     }
   }
 
- private:
   std::unique_ptr<LibSerial::SerialPort> owned_ = std::make_unique<LibSerial::SerialPort>();
   LibSerial::SerialPort& port_ = *owned_;
   std::string name_;
@@ -175,6 +181,20 @@ const IndexerDialect& IndexerDialect::Compumotor6k() {
   return d;
 }
 
+// A serial port is a terminal device: refuse anything else (a regular file,
+// /dev/null) before LibSerial's terminal calls fail on it.
+void CheckSerialDevice(const std::string& port) {
+  const std::string name = "serial port '" + ClipForMessage(port) + "'";
+  struct stat st {};
+  if (::stat(port.c_str(), &st) != 0) throw InputError(name + " does not exist");
+  if (!S_ISCHR(st.st_mode)) throw InputError(name + " is not a serial device (not a character device)");
+  const int fd = ::open(port.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) throw RigError(name + " cannot be opened: " + std::strerror(errno));
+  const bool tty = ::isatty(fd);
+  ::close(fd);
+  if (!tty) throw InputError(name + " is not a serial device (not a terminal)");
+}
+
 std::unique_ptr<SerialLine> OpenSerialPort(const std::string& port, int baud) {
   static const std::pair<int, LibSerial::BaudRate> kRates[] = {
       {1200, LibSerial::BaudRate::BAUD_1200},     {2400, LibSerial::BaudRate::BAUD_2400},
@@ -184,7 +204,7 @@ std::unique_ptr<SerialLine> OpenSerialPort(const std::string& port, int baud) {
       {230400, LibSerial::BaudRate::BAUD_230400}};
   for (const auto& [rate, code] : kRates)
     if (rate == baud) {
-      if (::access(port.c_str(), F_OK) != 0) throw RigError("serial port '" + port + "' does not exist");
+      CheckSerialDevice(port);
       return std::make_unique<LibSerialLine>(port, code);
     }
   throw RigError("serial baud rate " + std::to_string(baud) +

@@ -41,8 +41,8 @@ std::optional<RandomSceneSpec> ParseRandomSceneName(const std::string& name) {
   if (name.rfind("random", 0) != 0) return std::nullopt;
   static const std::regex kName(R"(^random(?::([0-9]{1,18})(?::([0-9]{1,2}))?)?$)");
   std::smatch m;
-  if (!std::regex_match(name, m, kName))
-    throw sim::SceneError("malformed random scene name '" + name +
+  if (name.size() > 40 || !std::regex_match(name, m, kName))
+    throw sim::SceneError("malformed random scene name '" + rig::ClipForMessage(name) +
                           "' (use random, random:SEED or random:SEED:N)");
   RandomSceneSpec spec;
   if (m[1].matched) spec.seed = std::stoull(m[1].str());

@@ -198,7 +198,7 @@ Mat MakeTexture(const std::string& kind, uint64_t seed, int size_px) {
     const int g = rng.uniform(120, 200);
     return Mat(size_px, size_px, CV_8UC3, cv::Scalar(g, g + 5, g + 10));
   }
-  throw sim::SceneError("unknown texture kind '" + kind + "'");
+  throw sim::SceneError("unknown texture kind '" + rig::ClipForMessage(kind) + "'");
 }
 
 std::optional<TextureName> ParseTextureName(const std::string& file_name) {

@@ -9,11 +9,11 @@ namespace sim {
 OffscreenRenderer::OffscreenRenderer(const mjModel* m, int width_px, int height_px)
     : width_px_(width_px), height_px_(height_px) {
   context_ = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, nullptr);
-  if (!context_) throw SceneError("cannot create an OSMesa rendering context");
+  if (!context_) throw rig::RigError("cannot create an OSMesa rendering context");
   window_buffer_.resize(static_cast<size_t>(width_px) * height_px * 4);
   if (!OSMesaMakeCurrent(context_, window_buffer_.data(), GL_UNSIGNED_BYTE, width_px, height_px)) {
     OSMesaDestroyContext(context_);
-    throw SceneError("cannot make the OSMesa rendering context current");
+    throw rig::RigError("cannot make the OSMesa rendering context current");
   }
   mjv_defaultScene(&scene_);
   mjv_makeScene(m, &scene_, 2000);

@@ -69,7 +69,7 @@ Box3 RigWorkspace(const SimRigConfig& c) {
 void CheckSceneRules(const World& w, const Box3& keep_out) {
   const mjModel* m = w.m;
   const mjData* d = w.d;
-  const std::string where = "scene '" + w.scene_path + "'";
+  const std::string where = "scene '" + rig::ClipForMessage(w.scene_path) + "'";
   const int rail = mj_name2id(m, mjOBJ_BODY, "tavt_rail");
   std::set<int> rig_joints(w.joint_ids.begin(), w.joint_ids.end());
   std::set<int> rig_actuators(w.actuator_ids.begin(), w.actuator_ids.end());

@@ -42,7 +42,8 @@ struct RigCalibration {
   Eigen::Vector3d left_optical_centre_H = Eigen::Vector3d::Zero();
   Eigen::Vector3d right_optical_centre_H = Eigen::Vector3d::Zero();
 };
-/// Throws RigError naming the file and the missing or bad entry.
+/// Reads a calibration file (a regular file of at most 64 MiB, OpenCV YAML).
+/// Throws InputError naming the file and the missing or bad entry.
 RigCalibration LoadCalibration(const std::string& path);
 void SaveCalibration(const std::string& path, const RigCalibration& calibration);
 

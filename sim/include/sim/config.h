@@ -6,13 +6,16 @@
 #include <stdexcept>
 #include <string>
 
+#include "rig/input_file.h"
+
 namespace sim {
 
 /// Thrown for a scene that cannot be loaded or breaks the scene rules, and for
-/// an invalid simulator configuration. The message names the file or key.
-class SceneError : public std::runtime_error {
+/// an invalid simulator configuration: input the user gave (the command line
+/// exits with 2). The message names the file or key.
+class SceneError : public rig::InputError {
  public:
-  using std::runtime_error::runtime_error;
+  using rig::InputError::InputError;
 };
 
 /// Sensor model applied to every captured image, in this order: Gaussian blur
