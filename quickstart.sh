@@ -9,7 +9,8 @@ export DEBIAN_FRONTEND=noninteractive
 
 # Debian 12 packages only; README "Dependencies" says what each is for.
 PACKAGES=(build-essential cmake pkg-config libmujoco-dev libosmesa6-dev libeigen3-dev
-          libopencv-dev catch2 libcli11-dev nlohmann-json3-dev libyaml-cpp-dev gnuplot-nox libserial-dev)
+          libopencv-dev catch2 libcli11-dev nlohmann-json3-dev libyaml-cpp-dev gnuplot-nox libserial-dev
+          clang-14 libclang-rt-14-dev)
 JOBS=$(nproc)
 
 install_packages() {
@@ -39,16 +40,18 @@ case "${1:-}" in
     mkdir -p out
     # The main job: a full FOVEA run (IDR, then 25 fixations) on the default
     # scene, cylinder_planes, scored against ground truth after each fixation.
-    ./build/experiments/fovea run --scene cylinder_planes --out out/run
+    # --force: replace the run an earlier quickstart wrote there (only that).
+    ./build/experiments/fovea run --scene cylinder_planes --out out/run --force
     echo "quickstart: pictures and figures are in out/run/ (summary.json, fixations.jsonl, map.ply, map_after_*.png, fixation_path.png)"
     ;;
   test)
     install_packages
     build build -DCMAKE_BUILD_TYPE=Release
     ctest --test-dir build -j "$JOBS" --output-on-failure
-    # Memory errors and undefined behaviour fail the suite too.
-    # -O1, no debug info: the usual sanitizer setting, and half the build time.
-    build build-asan -DCMAKE_BUILD_TYPE=None -DCMAKE_CXX_FLAGS=-O1 -DFOVEA_SANITIZE=ON
+    # Memory errors and undefined behaviour fail the suite too. Built with
+    # clang, whose libFuzzer drives the fuzz targets (label "fuzz", 30 s each)
+    # in the same build; -O1, no debug info: the usual sanitizer setting.
+    build build-asan -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=None -DCMAKE_CXX_FLAGS=-O1 -DFOVEA_SANITIZE=ON -DFOVEA_FUZZ=ON
     ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
       LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp:print_suppressions=0 \
       UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \

@@ -193,3 +193,33 @@ TEST_CASE("indexer driver: SIGTERM and a driver destroyed mid-move kill every ax
   }
   for (const int u : kUnits) CHECK(emulator.Kills(u) == 2);
 }
+
+TEST_CASE("indexer replies: framing, position and status parsed or refused, never misread", "[indexer]") {
+  const rig::IndexerDialect& d = rig::IndexerDialect::Compumotor6k();
+  using R = rig::IndexerDialect::Reply;
+  CHECK(d.ParseReply("").status == R::kIncomplete);
+  CHECK(d.ParseReply("*TPC+12").status == R::kIncomplete);
+  const R ok = d.ParseReply("*TPC+12800\r\n> ");
+  CHECK(ok.status == R::kOk);
+  CHECK(ok.text == "*TPC+12800");
+  const R bad = d.ParseReply("ERROR: bad command\r\n? ");
+  CHECK(bad.status == R::kRejected);
+  CHECK(bad.text == "ERROR: bad command");
+  CHECK(d.ParseReply("*TPC+1\x01\r\n> ").status == R::kGarbled);
+  CHECK(d.ParseReply("> ").status == R::kOk);  // a bare prompt: an empty reply
+  // Positions: signed whole step counts that fit a long, nothing else.
+  CHECK(d.ParsePosition("*TPC+12800") == 12800L);
+  CHECK(d.ParsePosition("*TPC-5") == -5L);
+  CHECK(d.ParsePosition("*TPC0") == 0L);
+  for (const char* unreadable : {"*TPC", "*TPC+", "*TPC 12", "*TPC+12x", "*TPE+12", "TPC+12",
+                                 "*TPC+99999999999999999999999", "*TPC--1"})
+    CHECK_FALSE(d.ParsePosition(unreadable));
+  // Status: exactly 32 bits in groups.
+  const std::string bits = "1000_0000_0000_0100_0000_0000_0000_0001";
+  const std::optional<std::string> parsed = d.ParseStatus("*TAS" + bits);
+  REQUIRE(parsed);
+  CHECK(*parsed == "10000000000001000000000000000001");
+  CHECK_FALSE(d.ParseStatus("*TAS1000_0000"));
+  CHECK_FALSE(d.ParseStatus("*TAS" + bits + "1"));
+  CHECK_FALSE(d.ParseStatus("*TAS" + bits.substr(0, 38) + "2"));
+}

@@ -71,16 +71,21 @@ CalibrationResult CalibrateStereo(const std::vector<std::string>& left_files,
       continue;
     }
     // A board with more corners than --board says holds sub-patterns of the
-    // stated size that the detectors find too (and left and right may pick
-    // different ones): refuse it.
+    // stated size that the detectors find too (left and right may pick
+    // different ones): the sector detector, allowed a larger board, reports
+    // the size it sees.
     for (int s = 0; s < 2; ++s) {
-      std::vector<cv::Point2f> more;
-      for (const cv::Size bigger : {cv::Size(cols + 1, rows), cv::Size(cols, rows + 1)})
-        if (cv::findChessboardCornersSB(img[s], bigger, more))
-          throw UsageError("calibrate: '" + rig::ClipForMessage(s == 0 ? left_files[i] : right_files[i]) +
-                           "' shows a board of at least " + std::to_string(bigger.width) + "x" +
-                           std::to_string(bigger.height) + " inner corners, not the " + std::to_string(cols) + "x" +
-                           std::to_string(rows) + " of --board: count the inner corners again");
+      std::vector<cv::Point2f> all;
+      cv::Mat meta;
+      if (cv::findChessboardCornersSB(img[s], pattern, all, cv::CALIB_CB_LARGER, meta) &&
+          meta.total() > static_cast<size_t>(cols) * rows) {
+        const bool same_way = (cols >= rows) == (meta.cols >= meta.rows);
+        const int seen_cols = same_way ? meta.cols : meta.rows, seen_rows = same_way ? meta.rows : meta.cols;
+        throw UsageError("calibrate: '" + rig::ClipForMessage(s == 0 ? left_files[i] : right_files[i]) +
+                         "' shows a board of " + std::to_string(seen_cols) + "x" + std::to_string(seen_rows) +
+                         " inner corners, not the " + std::to_string(cols) + "x" + std::to_string(rows) +
+                         " of --board: count the inner corners again");
+      }
     }
     object.push_back(board);
     left_points.push_back(corners[0]);

@@ -158,7 +158,7 @@ std::unique_ptr<rig::HardwareRig> MakeHardwareRig(const RunConfig& c, std::uniqu
   hw.calibration = rig::LoadCalibration(h.calibration);
   for (const rig::CameraIntrinsics* k : {&hw.calibration.left, &hw.calibration.right})
     if (k->width_px != c.rig.width_px || k->height_px != c.rig.height_px)
-      throw rig::RigError("calibration " + h.calibration + " is for " + std::to_string(k->width_px) + "x" +
+      throw rig::InputError("calibration " + rig::ClipForMessage(h.calibration) + " is for " + std::to_string(k->width_px) + "x" +
                           std::to_string(k->height_px) + " images, rig.width_px x rig.height_px is " +
                           std::to_string(c.rig.width_px) + "x" + std::to_string(c.rig.height_px));
   const double lin = c.rig.baseline_steps_per_mm * 1000, ang = c.rig.pan_tilt_steps_per_deg * 180 / M_PI;

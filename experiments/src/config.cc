@@ -55,6 +55,13 @@ void Assign(const ConfigParam& p, const std::string& text, const std::string& la
   const bool integral = !std::holds_alternative<double*>(p.target);
   if (integral && *v != std::floor(*v)) fail("expected a whole number, got " + shown);
   if (*v < p.lo || *v > p.hi) fail(rig::ClipForMessage(text) + " is out of range " + Range(p));
+  // Written as digits, a whole number is compared exactly: a double rounds
+  // 2^53 + 1 down to 2^53.
+  long long exact = 0;
+  const auto digits = std::from_chars(text.data(), text.data() + text.size(), exact);
+  if (integral && digits.ptr == text.data() + text.size() &&
+      (digits.ec != std::errc() || exact < static_cast<long long>(p.lo) || exact > static_cast<long long>(p.hi)))
+    fail(rig::ClipForMessage(text) + " is out of range " + Range(p));
   if (auto* d = std::get_if<double*>(&p.target)) **d = *v;
   else if (auto* i = std::get_if<int*>(&p.target)) **i = static_cast<int>(*v);
   else if (auto* u = std::get_if<uint64_t*>(&p.target)) **u = static_cast<uint64_t>(*v);

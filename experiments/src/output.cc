@@ -3,6 +3,8 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <climits>
+
 #include <cerrno>
 #include <cstdio>
 #include <filesystem>
@@ -47,6 +49,9 @@ bool IsEmptyFolder(const fs::path& p) {
 std::string NormalizeOutputPath(const std::string& path, const std::string& flag) {
   if (path.empty()) throw UsageError(flag + ": the output path is empty");
   fs::path p = fs::path(path).lexically_normal();
+  bool too_long = path.size() >= PATH_MAX;
+  for (const fs::path& part : p) too_long |= part.string().size() > NAME_MAX;
+  if (too_long) throw UsageError(flag + ": the output path is too long: " + Quoted(path));
   if (!p.has_filename()) p = p.parent_path();  // "out/run/" -> "out/run"
   const std::string last = p.filename().string();
   if (p.empty() || last.empty() || last == "." || last == ".." || p == p.root_path())
@@ -57,8 +62,9 @@ std::string NormalizeOutputPath(const std::string& path, const std::string& flag
 void CheckOutputTarget(const std::string& target, const std::string& flag, ExistingOutput existing) {
   std::error_code ec;
   const fs::file_status s = fs::symlink_status(target, ec);
-  if (ec || !fs::exists(s) || IsEmptyFolder(target)) return;
   const std::string at = flag + ": " + Quoted(target);
+  if (ec && ec != std::errc::no_such_file_or_directory) throw UsageError(at + " cannot be checked: " + ec.message());
+  if (!fs::exists(s) || IsEmptyFolder(target)) return;
   if (fs::is_symlink(s)) throw UsageError(at + " is a symbolic link; name a new folder");
   if (!fs::is_directory(s)) throw UsageError(at + " exists and is not a folder; name a new folder");
   if (existing == ExistingOutput::kRefuse)

@@ -97,8 +97,18 @@ bool ConcernsStatic(const std::string& path) {
 }  // namespace
 
 Sweep LoadSweep(const std::string& path) {
+  std::string text;
+  try {
+    text = rig::ReadInputFile(path, "file");
+  } catch (const rig::InputError& e) {
+    throw UsageError("sweep " + rig::ClipForMessage(path) + ": " + e.what());
+  }
+  return ParseSweep(text, path);
+}
+
+Sweep ParseSweep(const std::string& text, const std::string& path) {
   const std::string where = "sweep " + rig::ClipForMessage(path) + ": ";
-  const YAML::Node root = LoadYamlFile(path, where);
+  const YAML::Node root = ParseYaml(text, where);
   if (!root.IsMap()) throw UsageError(where + "expected a mapping with base, config, axes, baselines, jobs");
   Sweep sweep;
   sweep.file = path;

@@ -43,6 +43,10 @@ constexpr long kMaxSweepRuns = 10000;
 /// ("sweep FILE: ...") naming the key.
 Sweep LoadSweep(const std::string& path);
 
+/// The same for the text of a sweep file at `path` (a base config named in
+/// it is read relative to the folder of `path`).
+Sweep ParseSweep(const std::string& text, const std::string& path);
+
 /// The grid as written to DIR/grid.json: axes, and per run its id, variant,
 /// point and every parameter's value. Identical for every shard.
 nlohmann::json GridJson(const Sweep& sweep);

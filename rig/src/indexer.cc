@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <libserial/SerialPort.h>
@@ -154,6 +155,39 @@ std::string Trim(std::string s) {
 
 }  // namespace
 
+IndexerDialect::Reply IndexerDialect::ParseReply(const std::string& received) const {
+  if (Garbled(received)) return {Reply::kGarbled, ""};
+  const std::string framed = "\n" + received;
+  const size_t k_ok = framed.find("\n" + ok_prompt), k_bad = framed.find("\n" + error_prompt);
+  if (k_bad != std::string::npos && (k_ok == std::string::npos || k_bad < k_ok))
+    return {Reply::kRejected, Trim(framed.substr(0, k_bad))};
+  if (k_ok != std::string::npos) return {Reply::kOk, Trim(framed.substr(0, k_ok))};
+  return {Reply::kIncomplete, ""};
+}
+
+std::optional<long> IndexerDialect::ParsePosition(const std::string& reply) const {
+  if (reply.rfind(position_reply, 0) != 0) return std::nullopt;
+  const char* number = reply.c_str() + position_reply.size();
+  if (*number != '+' && *number != '-' && !std::isdigit(static_cast<unsigned char>(*number))) return std::nullopt;
+  errno = 0;
+  char* end = nullptr;
+  const long v = std::strtol(number, &end, 10);
+  if (end == number || *end != '\0' || errno == ERANGE) return std::nullopt;
+  return v;
+}
+
+std::optional<std::string> IndexerDialect::ParseStatus(const std::string& reply) const {
+  if (reply.rfind(status_reply, 0) != 0) return std::nullopt;
+  std::string bits;
+  for (size_t i = status_reply.size(); i < reply.size(); ++i) {
+    const char c = reply[i];
+    if (c == '0' || c == '1') bits += c;
+    else if (c != '_') return std::nullopt;
+  }
+  if (bits.size() != 32) return std::nullopt;
+  return bits;
+}
+
 std::string IndexerDialect::Format(IndexerCommand command, int unit, const std::string& value) const {
   std::string t = templates[static_cast<int>(command)];
   for (size_t p; (p = t.find("{u}")) != std::string::npos;) t.replace(p, 3, std::to_string(unit));
@@ -248,7 +282,6 @@ void IndexerDriver::Fail(const std::string& message) {
 }
 
 std::string IndexerDriver::Exchange(const std::string& command, const std::string& what) {
-  const std::string ok = "\n" + dialect_.ok_prompt, bad = "\n" + dialect_.error_prompt;
   for (int attempt = 0; attempt <= options_.retries; ++attempt) {
     // The retry waits a quarter as long (a reply that was merely late comes
     // then): a command that fails costs at most 1.25x the timeout.
@@ -261,12 +294,11 @@ std::string IndexerDriver::Exchange(const std::string& command, const std::strin
       const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
       if (left.count() <= 0) break;
       buf += line_->ReadSome(left);
-      if (Garbled(buf)) throw RigError(what + ": garbled reply from the indexer");
-      const std::string framed = "\n" + buf;
-      const size_t k_ok = framed.find(ok), k_bad = framed.find(bad);
-      if (k_bad != std::string::npos && (k_ok == std::string::npos || k_bad < k_ok))
-        throw RigError(what + ": the indexer rejected it: " + Trim(framed.substr(0, k_bad)));
-      if (k_ok != std::string::npos) return Trim(framed.substr(0, k_ok));
+      const IndexerDialect::Reply reply = dialect_.ParseReply(buf);
+      if (reply.status == IndexerDialect::Reply::kGarbled) throw RigError(what + ": garbled reply from the indexer");
+      if (reply.status == IndexerDialect::Reply::kRejected)
+        throw RigError(what + ": the indexer rejected it: " + ClipForMessage(reply.text));
+      if (reply.status == IndexerDialect::Reply::kOk) return reply.text;
     }
   }
   throw RigError(what + ": no complete reply within " + std::to_string(options_.reply_timeout.count()) +
@@ -297,13 +329,9 @@ std::array<long, kNumAxes> IndexerDriver::PositionSteps() {
   for (int i = 0; i < kNumAxes; ++i) {
     const int unit = options_.axes[i].unit;
     const std::string reply = Send(IndexerCommand::kPositionReport, unit);
-    const std::string& prefix = dialect_.position_reply;
-    char* end = nullptr;
-    const char* number = reply.c_str() + prefix.size();
-    const long v = reply.rfind(prefix, 0) == 0 ? std::strtol(number, &end, 10) : 0;
-    if (reply.rfind(prefix, 0) != 0 || end == number || *end != '\0')
-      Fail("unit " + std::to_string(unit) + ": unreadable position report '" + reply + "'");
-    steps[i] = v;
+    const std::optional<long> v = dialect_.ParsePosition(reply);
+    if (!v) Fail("unit " + std::to_string(unit) + ": unreadable position report '" + ClipForMessage(reply) + "'");
+    steps[i] = *v;
   }
   return steps;
 }
@@ -318,16 +346,9 @@ StageState IndexerDriver::Position() {
 std::string IndexerDriver::Status(Axis axis) {
   const int unit = options_.axes[static_cast<int>(axis)].unit;
   const std::string reply = Send(IndexerCommand::kStatus, unit);
-  const std::string& prefix = dialect_.status_reply;
-  std::string bits;
-  bool readable = reply.rfind(prefix, 0) == 0;
-  for (size_t i = prefix.size(); readable && i < reply.size(); ++i) {
-    const char c = reply[i];
-    if (c == '0' || c == '1') bits += c;
-    else readable = c == '_';
-  }
-  if (!readable || bits.size() != 32) Fail("unit " + std::to_string(unit) + ": unreadable status report '" + reply + "'");
-  return bits;
+  const std::optional<std::string> bits = dialect_.ParseStatus(reply);
+  if (!bits) Fail("unit " + std::to_string(unit) + ": unreadable status report '" + ClipForMessage(reply) + "'");
+  return *bits;
 }
 
 void IndexerDriver::KillAll() noexcept {

@@ -122,17 +122,25 @@ std::unique_ptr<Simulation> Simulation::LoadText(const std::string& name, const 
   return LoadImpl(name, xml, /*from_memory=*/true, config, assets);
 }
 
-std::unique_ptr<Simulation> Simulation::LoadImpl(const std::string& scene_path,
-                                                 const std::string& xml, bool from_memory,
-                                                 const SimRigConfig& config,
-                                                 const AssetProvider& assets) {
+namespace {
+
+// The scene compiled with the rig, its numbers finite and its rules kept:
+// everything of a load but the renderer. Throws SceneError.
+std::unique_ptr<World> CompileWorld(const std::string& scene_path, const std::string& xml, bool from_memory,
+                                    const SimRigConfig& config, const AssetProvider& assets) {
   mju_user_error = MujocoError;
   const std::string shown = rig::ClipForMessage(scene_path);
   if (xml.find("<mujoco") == std::string::npos)
     throw SceneError("scene file '" + shown + "' is not an MJCF model (no <mujoco> element)");
 
   // The rig model and any generated assets are served from memory.
-  auto vfs = std::make_unique<mjVFS>();
+  struct VfsDeleter {
+    void operator()(mjVFS* vfs) const {
+      mj_deleteVFS(vfs);
+      delete vfs;
+    }
+  };
+  const std::unique_ptr<mjVFS, VfsDeleter> vfs(new mjVFS);
   mj_defaultVFS(vfs.get());
   const std::string rig_xml = RigMjcf(config);
   AddToVfs(vfs.get(), kRigIncludeName, rig_xml.data(), rig_xml.size());
@@ -164,7 +172,6 @@ std::unique_ptr<Simulation> Simulation::LoadImpl(const std::string& scene_path,
   mju_user_warning = HoldWarning;
   mjModel* m = mj_loadXML(main_name.c_str(), vfs.get(), error, sizeof error);
   mju_user_warning = MujocoWarning;
-  mj_deleteVFS(vfs.get());
   if (!m) throw SceneError("cannot load scene '" + shown + "': " + OneLine(error));
   try {
     CheckFinite(m, "scene '" + shown + "'");
@@ -174,10 +181,8 @@ std::unique_ptr<Simulation> Simulation::LoadImpl(const std::string& scene_path,
   }
   for (const std::string& warning : g_load_warnings) MujocoWarning(warning.c_str());
 
-  mju_user_warning = MujocoWarning;
-  std::unique_ptr<Simulation> sim(new Simulation());
-  sim->world_ = std::make_unique<World>();
-  World& w = *sim->world_;
+  auto world = std::make_unique<World>();
+  World& w = *world;
   w.m = m;
   w.scene_path = scene_path;
   for (int i = 0; i < rig::kNumAxes; ++i) {
@@ -197,8 +202,24 @@ std::unique_ptr<Simulation> Simulation::LoadImpl(const std::string& scene_path,
   w.d = mj_makeData(m);
   mj_forward(m, w.d);
   CheckSceneRules(w, RigWorkspace(config));
-  w.renderer = new OffscreenRenderer(m, config.width_px, config.height_px);
+  return world;
+}
 
+}  // namespace
+
+void Simulation::CheckScene(const std::string& name, const std::string& xml, const SimRigConfig& config,
+                            const AssetProvider& assets) {
+  config.Check();
+  CompileWorld(name, xml, /*from_memory=*/true, config, assets);
+}
+
+std::unique_ptr<Simulation> Simulation::LoadImpl(const std::string& scene_path, const std::string& xml,
+                                                 bool from_memory, const SimRigConfig& config,
+                                                 const AssetProvider& assets) {
+  std::unique_ptr<Simulation> sim(new Simulation());
+  sim->world_ = CompileWorld(scene_path, xml, from_memory, config, assets);
+  World& w = *sim->world_;
+  w.renderer = new OffscreenRenderer(w.m, config.width_px, config.height_px);
   sim->rig_ = std::make_unique<SimRig>(sim->world_.get(), config);
   sim->truth_ = std::make_unique<GroundTruth>(sim->world_.get());
   sim->config_ = config;

@@ -7,6 +7,7 @@
 #include <array>
 #include <chrono>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,25 @@ struct IndexerDialect {
   int limit_bits[4] = {14, 15, 16, 17};  ///< hardware and soft limits hit
 
   std::string Format(IndexerCommand command, int unit, const std::string& value = "") const;
+
+  /// What the bytes received so far after a command say: no whole reply yet
+  /// (kIncomplete), a reply ended by the ok prompt (kOk, `text` the reply
+  /// before it, trimmed), one ended by the error prompt (kRejected, `text`
+  /// the error), or bytes no indexer sends (kGarbled: outside printable
+  /// ASCII, CR and LF). Total for any input.
+  struct Reply {
+    enum Status { kIncomplete, kOk, kRejected, kGarbled } status = kIncomplete;
+    std::string text;
+  };
+  Reply ParseReply(const std::string& received) const;
+
+  /// The step count of a position report ("*TPC+12800" -> 12800); nullopt
+  /// when the reply is not one or its number does not fit a long.
+  std::optional<long> ParsePosition(const std::string& reply) const;
+
+  /// The 32 status bits of a status report ("*TAS0000_0000_..."), as '0'
+  /// and '1' characters; nullopt when the reply is not one.
+  std::optional<std::string> ParseStatus(const std::string& reply) const;
 
   /// Compumotor 6000-series style: "1_A25000", "1_!K", "1_TPC" -> "*TPC+12800".
   static const IndexerDialect& Compumotor6k();

@@ -51,6 +51,12 @@ class Simulation {
   static std::unique_ptr<Simulation> LoadText(const std::string& name, const std::string& xml,
                                               const SimRigConfig& config,
                                               const AssetProvider& assets = {});
+  /// Compiles MJCF text with the rig and applies the checks a load applies
+  /// (finite numbers, the rig included, the scene rules) without creating a
+  /// renderer: cheap enough to check many scenes. Throws SceneError.
+  static void CheckScene(const std::string& name, const std::string& xml, const SimRigConfig& config,
+                         const AssetProvider& assets = {});
+
   ~Simulation();
   Simulation(const Simulation&) = delete;
   Simulation& operator=(const Simulation&) = delete;
