@@ -156,7 +156,7 @@ expect 2 "key 'matcher'" run --set matcher=census --out "$t/out"
 item=9
 expect 2 "is a folder" run --config "$t" --out "$t/out"
 expect 2 "key 'loop' appears twice" run --config "$in/dup.yaml" --out "$t/out"
-expect 2 "2 YAML documents" run --config "$in/two_docs.yaml" --out "$t/out"
+expect 2 "more than one YAML document" run --config "$in/two_docs.yaml" --out "$t/out"
 expect 2 "key 'seed' appears twice" sweep "$in/dup_axes.yaml" --out "$t/out"
 # [10] scenes with non-finite numbers, named
 item=10

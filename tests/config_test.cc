@@ -32,9 +32,11 @@ TEST_CASE("YAML: repeated keys, several documents and non-mappings are refused",
   using experiments::ParseYaml;
   CHECK_THROWS_WITH(ParseYaml("loop:\n  fixations: 3\nloop:\n  fixations: 4\n", ""), Catch::Contains("'loop' appears twice"));
   CHECK_THROWS_WITH(ParseYaml("a: {b: 1, b: 2}\n", ""), Catch::Contains("'b' appears twice"));
-  CHECK_THROWS_WITH(ParseYaml("seed: 1\n---\nseed: 2\n", ""), Catch::Contains("2 YAML documents"));
+  CHECK_THROWS_WITH(ParseYaml("seed: 1\n---\nseed: 2\n", ""), Catch::Contains("more than one YAML document"));
   CHECK_THROWS_WITH(ParseYaml("{[1]: 2}\n", ""), Catch::Contains("not a single value"));
+  CHECK_THROWS_WITH(ParseYaml(",", ""), Catch::Contains("not valid YAML"));  // yaml-cpp's LoadAll never returns
   CHECK_NOTHROW(ParseYaml("", ""));
+  CHECK_NOTHROW(ParseYaml("---\nseed: 3\n...\n", ""));
   experiments::RunConfig c;
   CHECK_THROWS_WITH(experiments::ApplyYaml(ParseYaml("[1, 2]\n", ""), &c, ""), Catch::Contains("mapping"));
 }
@@ -53,4 +55,11 @@ TEST_CASE("the dumped configuration reads back to the same dump and the same run
   CHECK(back.hardware.right_camera == "x\ny\t\"z'");
   CHECK(back.scene == "  spaced  ");
   CHECK(experiments::ConfigHash(back) == experiments::ConfigHash(c));
+}
+
+TEST_CASE("string parameters hold UTF-8 text without control characters", "[config]") {
+  experiments::RunConfig c;
+  CHECK_NOTHROW(experiments::SetParam(&c, "rig.port", "/dev/tty\xc3\xa9 \xe2\x82\xac \xf0\x9f\x93\xb7\t\n"));
+  for (const char* bad : {"a\x01", "a\x7f", "\x96", "\xc3", "\xc0\xaf", "\xed\xa0\x80", "\xf4\x90\x80\x80", "\xc2\x85"})
+    CHECK_THROWS_WITH(experiments::SetParam(&c, "rig.port", bad), Catch::Contains("UTF-8 text"));
 }

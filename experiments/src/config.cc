@@ -1,5 +1,6 @@
 #include "config.h"
 
+#include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -34,6 +35,33 @@ std::string Range(const ConfigParam& p) {
   return "[" + FormatNumber(p.lo) + ", " + FormatNumber(p.hi) + "]";
 }
 
+// Valid UTF-8 with no control character but tab and newline: the text a
+// string parameter may hold, which a YAML dump writes and reads back exactly.
+bool IsPlainText(const std::string& text) {
+  for (size_t i = 0; i < text.size();) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    int n = 0;  // continuation bytes
+    if (c >= 0xc2 && c <= 0xdf) n = 1;
+    else if (c >= 0xe0 && c <= 0xef) n = 2;
+    else if (c >= 0xf0 && c <= 0xf4) n = 3;
+    else if (c >= 0x80) return false;
+    if (i + n >= text.size()) return false;
+    unsigned long code = n == 0 ? c : c & (0x7f >> (n + 1));
+    for (int k = 1; k <= n; ++k) {
+      const auto cc = static_cast<unsigned char>(text[i + k]);
+      if ((cc & 0xc0) != 0x80) return false;
+      code = (code << 6) | (cc & 0x3f);
+    }
+    const bool control = code < 0x20 ? code != '\t' && code != '\n' : code >= 0x7f && code < 0xa0;
+    // Control characters, overlong forms, surrogates, past U+10FFFF.
+    if (control || (n == 2 && code < 0x800) || (n == 3 && (code < 0x10000 || code > 0x10ffff)) ||
+        (code >= 0xd800 && code <= 0xdfff))
+      return false;
+    i += n + 1;
+  }
+  return true;
+}
+
 // `label` names the parameter in messages: "key 'idr.sigma'" or "--sigma".
 void Assign(const ConfigParam& p, const std::string& text, const std::string& label) {
   auto fail = [&](const std::string& why) { throw UsageError(label + ": " + why); };
@@ -47,6 +75,7 @@ void Assign(const ConfigParam& p, const std::string& text, const std::string& la
   if (auto* s = std::get_if<std::string*>(&p.target)) {
     if (!p.choices.empty() && std::find(p.choices.begin(), p.choices.end(), text) == p.choices.end())
       fail(shown + " is not " + Range(p));
+    if (!IsPlainText(text)) fail("expected UTF-8 text without control characters (tabs and newlines aside)");
     **s = text;
     return;
   }
@@ -246,19 +275,48 @@ void CheckYamlTree(const YAML::Node& node, const std::string& where, long* budge
     for (const auto& item : node) CheckYamlTree(item, where, budget);
   }
 }
+
+// Records where each document of a YAML stream starts (nothing else).
+class DocumentStarts : public YAML::EventHandler {
+ public:
+  std::vector<YAML::Mark> starts;
+  void OnDocumentStart(const YAML::Mark& mark) override { starts.push_back(mark); }
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnAlias(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t, const std::string&) override {}
+  void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {}
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {}
+  void OnMapEnd() override {}
+};
+
 }  // namespace
 
 YAML::Node ParseYaml(const std::string& text, const std::string& where) {
-  std::vector<YAML::Node> docs;
+  auto invalid = [&](const YAML::Mark& mark, const std::string& why) {
+    return UsageError(where + "not valid YAML (line " + std::to_string(mark.line + 1) + ": " +
+                      rig::ClipForMessage(why) + ")");
+  };
+  YAML::Node root;
   try {
-    docs = YAML::LoadAll(text);
+    // One document, counted by the parser itself, which stops at the second
+    // (yaml-cpp 0.7's LoadAll never ends on a stray ',': its parser does not
+    // advance, so a document starting where the last one did is an error).
+    std::istringstream in(text);
+    YAML::Parser parser(in);
+    DocumentStarts documents;
+    while (documents.starts.size() < 2 && parser.HandleNextDocument(documents)) {
+    }
+    if (documents.starts.size() == 2) {
+      if (documents.starts[1].pos == documents.starts[0].pos) throw invalid(documents.starts[0], "unreadable text");
+      throw UsageError(where + "holds more than one YAML document (a second starts at line " +
+                       std::to_string(documents.starts[1].line + 1) + "); expected one");
+    }
+    root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
-    throw UsageError(where + "not valid YAML (line " + std::to_string(e.mark.line + 1) + ": " +
-                     rig::ClipForMessage(e.msg) + ")");
+    throw invalid(e.mark, e.msg);
   }
-  if (docs.size() > 1)
-    throw UsageError(where + "holds " + std::to_string(docs.size()) + " YAML documents; expected one");
-  const YAML::Node root = docs.empty() ? YAML::Node() : docs[0];
   long budget = 0;
   CheckYamlTree(root, where, &budget);
   return root;

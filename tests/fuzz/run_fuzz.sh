@@ -12,7 +12,7 @@ seconds=$4
 rm -rf "$work"
 mkdir -p "$work/corpus"
 cd "$work"
-"$target" -max_total_time="$seconds" -timeout=20 -rss_limit_mb=2048 -max_len=4096 -print_final_stats=1 \
+"$target" -max_total_time="$seconds" -timeout=20 -rss_limit_mb=4096 -max_len=4096 -print_final_stats=1 \
   -artifact_prefix="$work/" "$work/corpus" "$seeds" 2> "$work/fuzz.log" || {
   tail -40 "$work/fuzz.log" >&2
   echo "FAIL: $(basename "$target") found a problem; the input is in $work" >&2
