@@ -1,20 +1,24 @@
 // Stereo calibration against chessboards the simulator renders at known
 // poses: the recovered focal lengths and baseline against the true ones.
+#include "calibration.h"
+
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
 #include <filesystem>
 
-#include "calibration.h"
-
-TEST_CASE("calibration on simulator-rendered chessboards recovers focal length and baseline", "[calibration]") {
-  const std::string dir = (std::filesystem::temp_directory_path() / ("fovea_chessboards_" + std::to_string(getpid()))).string();
+TEST_CASE("calibration on simulator-rendered chessboards recovers focal length and baseline",
+          "[calibration]") {
+  const std::string dir =
+      (std::filesystem::temp_directory_path() / ("fovea_chessboards_" + std::to_string(getpid())))
+          .string();
   const experiments::SyntheticTruth truth = experiments::RenderChessboardViews(dir, 12, 0.025, 1);
   const experiments::CalibrationResult r = experiments::CalibrateStereo(
       experiments::Glob(dir + "/left_*.png"), experiments::Glob(dir + "/right_*.png"), 9, 6, 0.025);
-  INFO("fx left " << r.calibration.left.fx_px << ", right " << r.calibration.right.fx_px << ", true " << truth.fx_px
-                  << "; baseline " << r.baseline_m << " (true " << truth.baseline_m << "); RMS " << r.rms_left_px
-                  << " / " << r.rms_right_px << " / " << r.rms_stereo_px << " px");
+  INFO("fx left " << r.calibration.left.fx_px << ", right " << r.calibration.right.fx_px
+                  << ", true " << truth.fx_px << "; baseline " << r.baseline_m << " (true "
+                  << truth.baseline_m << "); RMS " << r.rms_left_px << " / " << r.rms_right_px
+                  << " / " << r.rms_stereo_px << " px");
   CHECK(r.views == 12);
   for (const rig::CameraIntrinsics* k : {&r.calibration.left, &r.calibration.right}) {
     CHECK(std::abs(k->fx_px - truth.fx_px) < 0.005 * truth.fx_px);

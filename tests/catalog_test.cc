@@ -1,13 +1,14 @@
 // The scene catalog: every scene loads, renders and has ground truth, and its
 // geometry is what the paper describes, measured by ray casting (not by
 // reading back the XML). Also the scene rules and the random generator.
+#include "scenes/catalog.h"
+
 #include <catch2/catch.hpp>
 #include <cmath>
-#include <opencv2/imgproc.hpp>
 #include <map>
+#include <opencv2/imgproc.hpp>
 #include <set>
 
-#include "scenes/catalog.h"
 #include "scenes/generated.h"
 #include "temp_scene.h"
 
@@ -47,8 +48,8 @@ TEST_CASE("every catalog scene loads, renders and has ground truth", "[scenes]")
     cv::meanStdDev(p.frame.left.gray, mean, stddev);
     CHECK(stddev[0] > 10);  // an image with content, not a blank
     cv::Mat ids;
-    const cv::Mat depth = p.sim->truth().RayCastDepth(p.frame.left.world_T_camera,
-                                                      p.frame.left.intrinsics, &ids);
+    const cv::Mat depth =
+        p.sim->truth().RayCastDepth(p.frame.left.world_T_camera, p.frame.left.intrinsics, &ids);
     CHECK(cv::countNonZero(depth > 0) == int(depth.total()));  // every pixel shows a surface
     double lo = 0, hi = 0;
     cv::minMaxLoc(depth, &lo, &hi);
@@ -64,7 +65,8 @@ TEST_CASE("fronto_planes: wood and tile planes 17 cm apart", "[scenes]") {
   CHECK(p.Name(tile) == "tile_plane");
   CHECK(tile.point_W.y() - wood.point_W.y() == Approx(0.17).margin(1e-9));
   // Both fronto-parallel: normals along -Y.
-  CHECK(std::abs(Normal(p.Hit(50, 100).point_W, p.Hit(150, 100).point_W, p.Hit(100, 400).point_W).y()) ==
+  CHECK(std::abs(
+            Normal(p.Hit(50, 100).point_W, p.Hit(150, 100).point_W, p.Hit(100, 400).point_W).y()) ==
         Approx(1).margin(1e-9));
 }
 
@@ -105,7 +107,8 @@ TEST_CASE("two_planes: the near plane covers part of the far one", "[scenes]") {
   CHECK(far.point_W.y() - near.point_W.y() == Approx(0.70).margin(1e-9));
 }
 
-TEST_CASE("three_surfaces: blocks 3 cm apart in depth, a 40 degree slant, a plane behind", "[scenes]") {
+TEST_CASE("three_surfaces: blocks 3 cm apart in depth, a 40 degree slant, a plane behind",
+          "[scenes]") {
   Probe p("three_surfaces");
   // Block front faces along the lower part of the view: fronto-parallel, so
   // many hits share one y (the blocks' sides give scattered values).
@@ -135,7 +138,8 @@ TEST_CASE("three_surfaces: blocks 3 cm apart in depth, a 40 degree slant, a plan
 TEST_CASE("periodic: the image repeats with the texture's period", "[scenes]") {
   Probe p("periodic");
   const double depth = p.Hit(319.5, 239.5).distance_m;
-  const double expected_px = p.frame.left.intrinsics.fx_px * 0.5 / 32 / depth;  // 0.5 m per 32 texels
+  const double expected_px =
+      p.frame.left.intrinsics.fx_px * 0.5 / 32 / depth;  // 0.5 m per 32 texels
   // Autocorrelation of the middle row: the first peak after zero lag.
   cv::Mat row;
   p.frame.left.gray.row(240).convertTo(row, CV_64F);
@@ -204,9 +208,10 @@ TEST_CASE("scene rules: nothing may drive the rig or reach into its workspace", 
   expect_error(TempScene(wall, TempScene::PhotoAsset(),
                          "<actuator><motor joint=\"tavt_left_pan\"/></actuator>"),
                "may not move the rig");
-  expect_error(TempScene(wall, TempScene::PhotoAsset(),
-                         "<equality><joint joint1=\"tavt_left_pan\" joint2=\"tavt_right_pan\"/></equality>"),
-               "may not move the rig");
+  expect_error(
+      TempScene(wall, TempScene::PhotoAsset(),
+                "<equality><joint joint1=\"tavt_left_pan\" joint2=\"tavt_right_pan\"/></equality>"),
+      "may not move the rig");
   // A floor well below the rig and a wall in front are fine.
   TempScene fine(wall + "<geom type=\"plane\" size=\"2 2 0.1\" pos=\"0 0 -0.5\"/>",
                  TempScene::PhotoAsset());

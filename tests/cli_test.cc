@@ -21,8 +21,10 @@ struct Result {
 
 // Runs `fovea ARGS`, capturing stderr.
 Result Fovea(const std::string& args) {
-  const fs::path err_file = fs::temp_directory_path() / ("fovea_cli_err_" + std::to_string(getpid()));
-  const std::string cmd = std::string(FOVEA_BIN) + " " + args + " >/dev/null 2>" + err_file.string();
+  const fs::path err_file =
+      fs::temp_directory_path() / ("fovea_cli_err_" + std::to_string(getpid()));
+  const std::string cmd =
+      std::string(FOVEA_BIN) + " " + args + " >/dev/null 2>" + err_file.string();
   const int status = std::system(cmd.c_str());
   std::ifstream in(err_file);
   std::stringstream ss;
@@ -34,7 +36,8 @@ Result Fovea(const std::string& args) {
 int Lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
 
 fs::path TempDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("fovea_cli_" + name + "_" + std::to_string(getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("fovea_cli_" + name + "_" + std::to_string(getpid()));
   fs::remove_all(dir);
   return dir;
 }
@@ -75,13 +78,14 @@ TEST_CASE("a user scene in any folder renders through the CLI", "[cli]") {
 TEST_CASE("fovea bench fixation prints the figures scripts rely on", "[cli][slow]") {
   const fs::path out = TempDir("bench");
   fs::create_directories(out);
-  const std::string cmd = std::string(FOVEA_BIN) + " bench fixation --json > " + (out / "b.json").string() + " 2>/dev/null";
+  const std::string cmd = std::string(FOVEA_BIN) + " bench fixation --json > " +
+                          (out / "b.json").string() + " 2>/dev/null";
   REQUIRE(std::system(cmd.c_str()) == 0);
   std::ifstream in(out / "b.json");
   std::string line;
   std::getline(in, line);
-  for (const char* key : {"\"foveated_ms\"", "\"full_res_ms\"", "\"sgbm_ms\"", "\"foveal_error_px\"",
-                          "\"full_res_error_px\"", "\"sgbm_error_px\""})
+  for (const char* key : {"\"foveated_ms\"", "\"full_res_ms\"", "\"sgbm_ms\"",
+                          "\"foveal_error_px\"", "\"full_res_error_px\"", "\"sgbm_error_px\""})
     CHECK(line.find(key) != std::string::npos);
   fs::remove_all(out);
 }
@@ -123,8 +127,10 @@ TEST_CASE("bad input gives one line on stderr, a non-zero exit and no output", "
       {"fixate --point 0 0.9 0 --matcher census", "matcher"},
       {"run --config " + (dir / "unknown.yaml").string(), "unknown key 'loop.fixation'"},
       {"run --config " + (dir / "type.yaml").string(), "key 'loop.fixations': expected a number"},
-      {"run --config " + (dir / "range.yaml").string(), "key 'foveal.baseline_m': -0.1 is out of range"},
-      {"run --config " + (dir / "zero.yaml").string(), "key 'loop.fixations': 0 is out of range [1, 10000]"},
+      {"run --config " + (dir / "range.yaml").string(),
+       "key 'foveal.baseline_m': -0.1 is out of range"},
+      {"run --config " + (dir / "zero.yaml").string(),
+       "key 'loop.fixations': 0 is out of range [1, 10000]"},
       {"run --config " + (dir / "bad.yaml").string(), "not valid YAML"},
       {"run --config /nonexistent/run.yaml", "cannot be read"},
       {"run --scene no_such_scene", "unknown scene"},
@@ -143,7 +149,8 @@ TEST_CASE("bad input gives one line on stderr, a non-zero exit and no output", "
   fs::remove_all(dir);
 }
 
-TEST_CASE("bad sweep files each give one line naming the key, exit 2 and no output folder", "[cli][sweep]") {
+TEST_CASE("bad sweep files each give one line naming the key, exit 2 and no output folder",
+          "[cli][sweep]") {
   const fs::path out = TempDir("sweep_bad");
   const fs::path dir = TempDir("sweeps");
   fs::create_directories(dir);
@@ -151,19 +158,26 @@ TEST_CASE("bad sweep files each give one line naming the key, exit 2 and no outp
     std::string name, text, expect;
   };
   const std::vector<Case> cases = {
-      {"unknown_key", "config: {loop: {fixation: 3}}\naxes: {seed: [0, 1]}\n", "unknown key 'loop.fixation'"},
-      {"wrong_type", "config: {loop: {fixations: many}}\naxes: {seed: [0, 1]}\n", "key 'loop.fixations': expected a number"},
-      {"negative_baseline", "axes: {foveal.baseline_m: [0.1, -0.1]}\n", "key 'foveal.baseline_m': -0.1 is out of range"},
-      {"zero_fixations", "axes: {loop.fixations: [0, 5]}\n", "key 'loop.fixations': 0 is out of range [1, 10000]"},
-      {"missing_scene", "axes: {scene: [two_planes, no_such_scene]}\n", "unknown scene 'no_such_scene'"},
-      {"missing_scene_file", "axes: {scene: [/nonexistent/scene.xml]}\n", "scene '/nonexistent/scene.xml': no such file"},
+      {"unknown_key", "config: {loop: {fixation: 3}}\naxes: {seed: [0, 1]}\n",
+       "unknown key 'loop.fixation'"},
+      {"wrong_type", "config: {loop: {fixations: many}}\naxes: {seed: [0, 1]}\n",
+       "key 'loop.fixations': expected a number"},
+      {"negative_baseline", "axes: {foveal.baseline_m: [0.1, -0.1]}\n",
+       "key 'foveal.baseline_m': -0.1 is out of range"},
+      {"zero_fixations", "axes: {loop.fixations: [0, 5]}\n",
+       "key 'loop.fixations': 0 is out of range [1, 10000]"},
+      {"missing_scene", "axes: {scene: [two_planes, no_such_scene]}\n",
+       "unknown scene 'no_such_scene'"},
+      {"missing_scene_file", "axes: {scene: [/nonexistent/scene.xml]}\n",
+       "scene '/nonexistent/scene.xml': no such file"},
       {"not_yaml", "axes: [1, 2\n", "not valid YAML"},
       {"unknown_axis", "axes: {foveal.nope: [1, 2]}\n", "unknown key 'foveal.nope'"},
       {"no_axes", "config: {seed: 3}\n", "key 'axes'"},
       {"bad_range", "axes: {seed: {from: 3, to: 1, step: 1}}\n", "range needs from <= to"},
       {"unknown_top_key", "axis: {seed: [0]}\n", "unknown key 'axis'"},
       {"missing_base", "base: nope.yaml\naxes: {seed: [0]}\n", "cannot be read"},
-      {"too_wide", "config: {rig: {carriage_max_m: 0.05}}\naxes: {foveal.baseline_m: [0.08, 0.12]}\n",
+      {"too_wide",
+       "config: {rig: {carriage_max_m: 0.05}}\naxes: {foveal.baseline_m: [0.08, 0.12]}\n",
        "key 'foveal.baseline_m': 0.12 is wider than the carriages allow"},
       {"unknown_baseline", "axes: {seed: [0]}\nbaselines: [oracle]\n", "'oracle' is not one of"},
       {"bad_jobs", "axes: {seed: [0]}\njobs: -1\n", "key 'jobs'"},
@@ -181,9 +195,10 @@ TEST_CASE("bad sweep files each give one line naming the key, exit 2 and no outp
   }
   const fs::path good = dir / "good.yaml";
   std::ofstream(good) << "axes: {seed: [0, 1]}\n";
-  for (const std::string& args : std::vector<std::string>{"sweep /nonexistent/sweep.yaml", "sweep " + good.string() + " --shard 3/2",
-                                  "sweep " + good.string() + " --shard x", "collect /nonexistent/folder",
-                                  "report /nonexistent/folder"}) {
+  for (const std::string& args : std::vector<std::string>{
+           "sweep /nonexistent/sweep.yaml", "sweep " + good.string() + " --shard 3/2",
+           "sweep " + good.string() + " --shard x", "collect /nonexistent/folder",
+           "report /nonexistent/folder"}) {
     const Result r = Fovea(args + (args.rfind("sweep", 0) == 0 ? " --out " + out.string() : ""));
     INFO(args << " -> exit " << r.exit_code << ": " << r.err);
     CHECK(r.exit_code == 2);
@@ -193,33 +208,43 @@ TEST_CASE("bad sweep files each give one line naming the key, exit 2 and no outp
   fs::remove_all(dir);
 }
 
-TEST_CASE("hardware rig setup errors are one line, non-zero exit and no output", "[cli][hardware]") {
+TEST_CASE("hardware rig setup errors are one line, non-zero exit and no output",
+          "[cli][hardware]") {
   const fs::path out = TempDir("hw_bad");
   const fs::path dir = TempDir("hw");
   fs::create_directories(dir);
   const std::string configs = std::string(FOVEA_SCENES_DIR) + "/../experiments/configs";
-  const std::string base = "run --config " + configs + "/emulated-hardware.yaml --set rig.calibration=" + configs +
+  const std::string base = "run --config " + configs +
+                           "/emulated-hardware.yaml --set rig.calibration=" + configs +
                            "/emulated-hardware-calibration.yaml";
   // A calibration for another image size.
-  std::ofstream(dir / "small.yaml") << "%YAML:1.0\n---\nleft: {width_px: 320, height_px: 240, fx_px: 600., fy_px: 600., "
-                                       "cx_px: 159.5, cy_px: 119.5}\nright: {width_px: 320, height_px: 240, fx_px: 600., "
-                                       "fy_px: 600., cx_px: 159.5, cy_px: 119.5}\n";
+  std::ofstream(dir / "small.yaml")
+      << "%YAML:1.0\n---\nleft: {width_px: 320, height_px: 240, fx_px: 600., fy_px: 600., "
+         "cx_px: 159.5, cy_px: 119.5}\nright: {width_px: 320, height_px: 240, fx_px: 600., "
+         "fy_px: 600., cx_px: 159.5, cy_px: 119.5}\n";
   std::ofstream(dir / "broken.yaml") << "%YAML:1.0\n---\nleft: {width_px: 640}\n";
   struct Case {
     std::string args, expect;
   };
   const std::vector<Case> cases = {
-      {base + " --set rig.emulate_stages=false --set rig.port=/dev/ttyNOPE0", "serial port '/dev/ttyNOPE0' does not exist"},
+      {base + " --set rig.emulate_stages=false --set rig.port=/dev/ttyNOPE0",
+       "serial port '/dev/ttyNOPE0' does not exist"},
       {base + " --set rig.baud=12345", "baud rate 12345"},
-      {base + " --set rig.left_camera=/nonexistent/left_%05d.png", "camera '/nonexistent/left_%05d.png' cannot be opened"},
+      {base + " --set rig.left_camera=/nonexistent/left_%05d.png",
+       "camera '/nonexistent/left_%05d.png' cannot be opened"},
       {base + " --set rig.calibration=" + (dir / "small.yaml").string(), "is for 320x240 images"},
-      {base + " --set rig.calibration=" + (dir / "broken.yaml").string(), "missing number 'height_px'"},
+      {base + " --set rig.calibration=" + (dir / "broken.yaml").string(),
+       "missing number 'height_px'"},
       {base + " --set rig.calibration=/nonexistent/calibration.yaml", "cannot be read"},
       {base + " --set rig.emulate_stages=false", "key 'rig.port'"},
       {base + " --set rig.units=1,2,3,4,5,5", "key 'rig.units': address 5 appears twice"},
       {base + " --set rig.directions=1,1,1,1,2,1", "key 'rig.directions'"},
-      {"calibrate --left '/nonexistent/*.png' --right '/nonexistent/*.png' --board 9x6 --square 0.025", "no files match"},
-      {"calibrate --left '/nonexistent/*.png' --right '/nonexistent/*.png' --board 9by6 --square 0.025", "--board expects WxH"},
+      {"calibrate --left '/nonexistent/*.png' --right '/nonexistent/*.png' --board 9x6 --square "
+       "0.025",
+       "no files match"},
+      {"calibrate --left '/nonexistent/*.png' --right '/nonexistent/*.png' --board 9by6 --square "
+       "0.025",
+       "--board expects WxH"},
   };
   for (const Case& c : cases) {
     const Result r = Fovea(c.args + " --out " + out.string());

@@ -1,12 +1,13 @@
 // The full FOVEA run as a user runs it (fovea run): records, summary,
 // reproducibility, local suppression, the paper's near-then-far behaviour.
+#include <unistd.h>
+
 #include <catch2/catch.hpp>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
-#include <unistd.h>
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -14,13 +15,15 @@ using nlohmann::json;
 namespace {
 
 fs::path Out(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("fovea_ddr_" + name + "_" + std::to_string(getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("fovea_ddr_" + name + "_" + std::to_string(getpid()));
   fs::remove_all(dir);
   return dir;
 }
 
 void RunFovea(const std::string& args, const fs::path& out) {
-  const std::string cmd = std::string(FOVEA_BIN) + " run " + args + " --out " + out.string() + " 2>/dev/null";
+  const std::string cmd =
+      std::string(FOVEA_BIN) + " run " + args + " --out " + out.string() + " 2>/dev/null";
   REQUIRE(std::system(cmd.c_str()) == 0);
 }
 
@@ -75,31 +78,36 @@ TEST_CASE("fovea run: the same seed gives the same run, another seed another one
   for (const auto& d : {a, b, c}) fs::remove_all(d);
 }
 
-TEST_CASE("fovea run on two_planes: near plane first, then the far one, with its outputs and summary keys", "[ddr][slow]") {
+TEST_CASE(
+    "fovea run on two_planes: near plane first, then the far one, with its outputs and summary "
+    "keys",
+    "[ddr][slow]") {
   const fs::path out = Out("two");
   RunFovea("--scene two_planes", out);
   const auto records = Records(out);
   const json s = Summary(out);
-  for (const char* key : {"scene", "seed", "fixations", "coverage", "foveal_coverage", "median_abs_error_m",
-                          "median_rel_error", "rmse_m", "compute_time_s", "motion_time_s", "wall_time_s"}) {
+  for (const char* key :
+       {"scene", "seed", "fixations", "coverage", "foveal_coverage", "median_abs_error_m",
+        "median_rel_error", "rmse_m", "compute_time_s", "motion_time_s", "wall_time_s"}) {
     INFO(key);
     CHECK(s.contains(key));
   }
   CHECK(s["fixations"] == 25);
-  for (const char* f : {"map.ply", "fixation_path.png", "map_after_01.png", "map_after_05.png", "map_after_15.png",
-                        "map_after_25.png", "config.yaml"})
+  for (const char* f : {"map.ply", "fixation_path.png", "map_after_01.png", "map_after_05.png",
+                        "map_after_15.png", "map_after_25.png", "config.yaml"})
     CHECK(fs::exists(out / f));
   // Near plane at y = 0.6 m, far plane at 1.3 m.
   std::vector<bool> near;
   for (const auto& r : records)
     if (r["ok"]) near.push_back(r["fixation_W"][1].get<double>() < 0.95);
   REQUIRE(near.size() == 25);
-  for (int i = 0; i < 5; ++i) CHECK(near[i]);  // stays on the near plane for a while
+  for (int i = 0; i < 5; ++i) CHECK(near[i]);              // stays on the near plane for a while
   CHECK(std::count(near.begin(), near.end(), false) > 0);  // then moves to the far one
   const auto first_far = std::find(near.begin(), near.end(), false) - near.begin();
   CHECK(std::count(near.begin() + first_far, near.end(), true) <= 2);  // and mostly stays there
   // The map's foveal share grows with fixations; the whole map stays accurate.
-  const double f1 = records.front()["score"]["foveal_coverage"], f25 = records.back()["score"]["foveal_coverage"];
+  const double f1 = records.front()["score"]["foveal_coverage"],
+               f25 = records.back()["score"]["foveal_coverage"];
   CHECK(f25 > f1);
   CHECK(s["median_rel_error"].get<double>() < 0.01);
   CHECK(s["coverage"].get<double>() >= 0.95);  // measured 0.989
@@ -109,7 +117,8 @@ TEST_CASE("fovea run on two_planes: near plane first, then the far one, with its
 TEST_CASE("local suppression: without it, fixations revisit mapped places more", "[ddr][slow]") {
   auto revisits = [](const std::string& suppression) {
     const fs::path out = Out("sup" + suppression);
-    RunFovea("--scene cylinder_planes --fixations 12 --set criteria.suppression=" + suppression, out);
+    RunFovea("--scene cylinder_planes --fixations 12 --set criteria.suppression=" + suppression,
+             out);
     std::vector<Eigen::Vector3d> pts;
     for (const auto& r : Records(out))
       if (r["ok"]) pts.emplace_back(r["fixation_W"][0], r["fixation_W"][1], r["fixation_W"][2]);

@@ -2,8 +2,8 @@
 // scored against ground truth. Slow: labelled [slow].
 #include <catch2/catch.hpp>
 
-#include "foveal_eval.h"
 #include "fovea/idr.h"
+#include "foveal_eval.h"
 #include "scenes/catalog.h"
 
 TEST_CASE("foveal and peripheral depth accuracy at three fixations per scene", "[foveal][slow]") {
@@ -14,12 +14,10 @@ TEST_CASE("foveal and peripheral depth accuracy at three fixations per scene", "
   // Cylinder front, left plane, right plane; slanted fabric (two points),
   // plywood behind. (The wooden blocks, 6 degrees below the rig's horizon at
   // 0.53 m, get a fovea of a few pixels: see the README's known limitations.)
-  const std::vector<Point> points = {{"cylinder_planes", {0.0, 0.89, 0.0}},
-                                     {"cylinder_planes", {-0.2, 0.93, 0.05}},
-                                     {"cylinder_planes", {0.25, 1.0, -0.05}},
-                                     {"three_surfaces", {0.09, 0.86, 0.05}},
-                                     {"three_surfaces", {0.15, 0.91, 0.1}},
-                                     {"three_surfaces", {-0.25, 1.2, 0.1}}};
+  const std::vector<Point> points = {
+      {"cylinder_planes", {0.0, 0.89, 0.0}},   {"cylinder_planes", {-0.2, 0.93, 0.05}},
+      {"cylinder_planes", {0.25, 1.0, -0.05}}, {"three_surfaces", {0.09, 0.86, 0.05}},
+      {"three_surfaces", {0.15, 0.91, 0.1}},   {"three_surfaces", {-0.25, 1.2, 0.1}}};
   sim::SimRigConfig config;
   config.noise.read_noise_sigma_dn = 2.0;
   for (const Point& pt : points) {
@@ -43,7 +41,8 @@ TEST_CASE("foveal and peripheral depth accuracy at three fixations per scene", "
   }
 }
 
-TEST_CASE("where the map is silent, a surface outside Z_T gives no false patches", "[foveal][slow]") {
+TEST_CASE("where the map is silent, a surface outside Z_T gives no false patches",
+          "[foveal][slow]") {
   // Fixating the plywood at 1.2 m with nothing mapped: the wooden blocks at
   // 0.50-0.56 m lie far outside Z_T, and the paper's search of the Z_T band
   // takes false matches of their grain for surfaces in the band.
@@ -52,12 +51,13 @@ TEST_CASE("where the map is silent, a surface outside Z_T gives no false patches
   auto gross = [&](double silent_near_m) {
     auto sim = scenes::LoadScene("three_surfaces", config);
     fovea::FixationOptions o;
-    o.baseline_m = 0.12;  // Z_T about -0.15 / +0.2 m around 1.2 m: the blocks far outside it
+    o.baseline_m = 0.12;         // Z_T about -0.15 / +0.2 m around 1.2 m: the blocks far outside it
     o.choose_placement = false;  // carriages symmetric, as measured
     o.foveal.silent_near_m = silent_near_m;
     const fovea::Nl1Matcher matcher;
     const Eigen::Vector3d plywood(-0.25, 1.2, 0.1);
-    const fovea::FixationResult r = fovea::Fixate(sim->rig(), fovea::PatchMap(), plywood, matcher, o);
+    const fovea::FixationResult r =
+        fovea::Fixate(sim->rig(), fovea::PatchMap(), plywood, matcher, o);
     REQUIRE(r.ok);
     REQUIRE((r.fixation_W - plywood).norm() < 0.02);  // the servo held the plywood point
     const experiments::FovealScore s = experiments::ScoreFoveal(r, sim->truth());
@@ -69,9 +69,10 @@ TEST_CASE("where the map is silent, a surface outside Z_T gives no false patches
     return std::make_pair(n, patches);
   };
   const auto paper = gross(0.0), ours = gross(0.4);
-  INFO("patches off by over 5%: paper's band " << paper.first << " of " << paper.second << ", wider check "
-                                               << ours.first << " of " << ours.second);
+  INFO("patches off by over 5%: paper's band " << paper.first << " of " << paper.second
+                                               << ", wider check " << ours.first << " of "
+                                               << ours.second);
   CHECK(paper.first >= 5);
-  CHECK(ours.first * 2 <= paper.first);  // measured 4 against 14
+  CHECK(ours.first * 2 <= paper.first);              // measured 4 against 14
   CHECK(ours.second >= paper.second - paper.first);  // the right patches stay
 }

@@ -1,6 +1,7 @@
+#include "fovea/geometry.h"
+
 #include <catch2/catch.hpp>
 
-#include "fovea/geometry.h"
 #include "rig/kinematics.h"
 
 TEST_CASE("a world point projects where its pixel ray passes", "[fovea][geometry]") {
@@ -29,6 +30,6 @@ TEST_CASE("midpoint triangulation recovers a point seen by two cameras", "[fovea
   CHECK((t->p_W - p_W).norm() < 1e-9);
   CHECK(t->miss_distance_m < 1e-9);
   // Parallel rays do not meet.
-  CHECK_FALSE(fovea::TriangulateMidpoint(a, fovea::Ray{a.origin_W + Eigen::Vector3d(0.1, 0, 0),
-                                                       a.direction_W}));
+  CHECK_FALSE(fovea::TriangulateMidpoint(
+      a, fovea::Ray{a.origin_W + Eigen::Vector3d(0.1, 0, 0), a.direction_W}));
 }

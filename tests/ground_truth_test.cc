@@ -25,7 +25,8 @@ TEST_CASE("rendered depth agrees with exact ray casting on a fronto-parallel pla
   double worst_render = 0, worst_cast = 0;
   for (int v = 0; v < rendered.rows; ++v)
     for (int u = 0; u < rendered.cols; ++u) {
-      worst_render = std::max<double>(worst_render, std::abs(rendered.at<float>(v, u) - cast.at<float>(v, u)));
+      worst_render =
+          std::max<double>(worst_render, std::abs(rendered.at<float>(v, u) - cast.at<float>(v, u)));
       worst_cast = std::max<double>(worst_cast, std::abs(cast.at<float>(v, u) - expected));
       REQUIRE(sim->truth().GeomName(ids.at<int>(v, u)) == "plane");
     }
@@ -47,7 +48,8 @@ TEST_CASE("ray casts hit scene geoms only and report distance and point", "[sim]
   CHECK(slanted->distance_m == Approx(1.0 / std::cos(0.2)).margin(1e-9));
 }
 
-TEST_CASE("ray-cast depth works for any intrinsics, rendering refuses what it cannot draw", "[sim]") {
+TEST_CASE("ray-cast depth works for any intrinsics, rendering refuses what it cannot draw",
+          "[sim]") {
   auto sim = scenes::LoadScene(PlaneScene().path(), sim::SimRigConfig{});
   const rig::CameraView view = sim->rig().Capture().left;
   rig::CameraIntrinsics k = view.intrinsics;

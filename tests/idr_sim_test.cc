@@ -25,7 +25,8 @@ Run RunOn(const std::string& scene, const fovea::IdrOptions& options = {}) {
 
 }  // namespace
 
-TEST_CASE("IDR on the step scenes: unambiguous start, sub-step depth, no straddling", "[idr][slow]") {
+TEST_CASE("IDR on the step scenes: unambiguous start, sub-step depth, no straddling",
+          "[idr][slow]") {
   const fovea::IdrOptions options;
   for (const std::string scene : {"fronto_planes", "two_planes", "periodic"}) {
     INFO(scene);
@@ -48,7 +49,8 @@ TEST_CASE("IDR on the step scenes: unambiguous start, sub-step depth, no straddl
   }
 }
 
-TEST_CASE("periodic texture: the period rule avoids the wrong matches a fixed baseline makes", "[idr][slow]") {
+TEST_CASE("periodic texture: the period rule avoids the wrong matches a fixed baseline makes",
+          "[idr][slow]") {
   // Both runs take the nearest candidate when a window is ambiguous, as a
   // classic matcher does: only the baseline rule differs.
   fovea::IdrOptions adaptive;

@@ -1,9 +1,9 @@
 // IDR's pieces on synthetic images with known answers.
+#include "fovea/idr.h"
+
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
-
-#include "fovea/idr.h"
 
 namespace {
 
@@ -48,9 +48,11 @@ TEST_CASE("matching a shifted texture recovers its disparity", "[fovea][idr]") {
     INFO("disparity " << d);
     const cv::Mat right = Shift(left, d);
     fovea::ZeroCrossingOptions zo;
-    const auto zl = fovea::ExtractZeroCrossings(left, zo), zr = fovea::ExtractZeroCrossings(right, zo);
+    const auto zl = fovea::ExtractZeroCrossings(left, zo),
+               zr = fovea::ExtractZeroCrossings(right, zo);
     fovea::ZcMatchStats stats;
-    const auto matches = fovea::MatchZeroCrossings(zl, zr, Global(0, 14), Global(0, 14), {}, &stats);
+    const auto matches =
+        fovea::MatchZeroCrossings(zl, zr, Global(0, 14), Global(0, 14), {}, &stats);
     REQUIRE(matches.size() > 0.6 * zl.crossings.size());
     int close = 0;
     for (const auto& m : matches)
@@ -68,7 +70,8 @@ TEST_CASE("a window wider than the period makes periodic matches ambiguous", "[f
   for (int x = 0; x < left.cols; ++x)
     left.col(x).setTo(cv::saturate_cast<uchar>(128 + 70 * std::sin(2 * M_PI * x / period)));
   const cv::Mat right = Shift(left, d);
-  const auto zl = fovea::ExtractZeroCrossings(left, {}), zr = fovea::ExtractZeroCrossings(right, {});
+  const auto zl = fovea::ExtractZeroCrossings(left, {}),
+             zr = fovea::ExtractZeroCrossings(right, {});
   fovea::ZcMatchStats narrow, wide, nearest;
   const auto good = fovea::MatchZeroCrossings(zl, zr, Global(0, 15), Global(0, 15), {}, &narrow);
   CHECK(narrow.UnambiguousShare() > 0.99);
@@ -83,7 +86,8 @@ TEST_CASE("a window wider than the period makes periodic matches ambiguous", "[f
   take.take_nearest_when_ambiguous = true;
   const cv::Mat far_right = Shift(left, d + period);  // true disparity 26
   const auto zf = fovea::ExtractZeroCrossings(far_right, {});
-  const auto wrong = fovea::MatchZeroCrossings(zl, zf, Global(0, 45), Global(0, 45), take, &nearest);
+  const auto wrong =
+      fovea::MatchZeroCrossings(zl, zf, Global(0, 45), Global(0, 45), take, &nearest);
   REQUIRE(wrong.size() > 0.5 * zl.crossings.size());
   const auto aliased = std::count_if(wrong.begin(), wrong.end(), [&](const auto& m) {
     return std::abs(m.disparity_px - d) < 0.1;  // one period short of the truth
@@ -98,7 +102,8 @@ TEST_CASE("expansion factor from the minimum separation and the slant limit", "[
   const double g = 5 * 10 * std::tan(M_PI / 3) / 1000;
   CHECK(fovea::ExpansionFactor(10, 5, 1000, M_PI / 3) == Approx(10 / (1 + g)));
   // Larger disparities allow less expansion.
-  CHECK(fovea::ExpansionFactor(10, 50, 1000, M_PI / 3) < fovea::ExpansionFactor(10, 5, 1000, M_PI / 3));
+  CHECK(fovea::ExpansionFactor(10, 50, 1000, M_PI / 3) <
+        fovea::ExpansionFactor(10, 5, 1000, M_PI / 3));
 }
 
 TEST_CASE("per-crossing windows come from nearby anchors", "[fovea][idr]") {
@@ -137,7 +142,8 @@ TEST_CASE("patches from disparities back-project to the right depth", "[fovea][i
   std::vector<fovea::DisparitySample> samples;
   for (int y = 0; y < 96; ++y)
     for (int x = 0; x < 128; x += 3) samples.push_back({x + 0.2, double(y), d});
-  const fovea::PatchMap map = fovea::PatchesFromDisparities(samples, view, baseline, 16, {}, fovea::PatchLevel::kIdr);
+  const fovea::PatchMap map =
+      fovea::PatchesFromDisparities(samples, view, baseline, 16, {}, fovea::PatchLevel::kIdr);
   CHECK(map.size() == (128 / 16) * (96 / 16));
   for (const auto& p : map.patches()) {
     for (const auto& c : p.corners_W) CHECK(c.z() == Approx(z).margin(1e-9));

@@ -1,5 +1,7 @@
 // The serial stage driver against the indexer emulator on a pseudo-terminal:
 // every command, every injected fault, and a long random sequence of moves.
+#include "rig/indexer.h"
+
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -8,7 +10,6 @@
 #include <chrono>
 #include <random>
 
-#include "rig/indexer.h"
 #include "rig/indexer_emulator.h"
 
 namespace {
@@ -46,7 +47,9 @@ rig::StageState Pose(double lb, double lp, double lt, double rb, double rp, doub
   return rig::StageState::FromArray({lb, lp, lt, rb, rp, rt});
 }
 
-double Seconds(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+double Seconds(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
 
 }  // namespace
 
@@ -80,7 +83,8 @@ TEST_CASE("indexer driver: every command against the emulator", "[indexer]") {
   CHECK(driver.Send(IndexerCommand::kKill, 3).empty());
   CHECK(emulator.Kills(3) == 1);
   // A rejected command is an error naming it, and kills every axis.
-  CHECK_THROWS_WITH(driver.Send(IndexerCommand::kDistance, 1, "1.5"), Catch::Contains("rejected") && Catch::Contains("1_D1.5"));
+  CHECK_THROWS_WITH(driver.Send(IndexerCommand::kDistance, 1, "1.5"),
+                    Catch::Contains("rejected") && Catch::Contains("1_D1.5"));
   for (const int u : kUnits) CHECK(emulator.Kills(u) >= 1);
 }
 
@@ -91,15 +95,19 @@ TEST_CASE("indexer driver: moves, read-back and soft limits", "[indexer]") {
   const rig::MoveResult r = driver.MoveTo(target);
   const auto want = target.ToArray(), got = r.reached.ToArray();
   for (int i = 0; i < rig::kNumAxes; ++i) CHECK(got[i] == Approx(want[i]).margin(1e-5));
-  CHECK(emulator.Position(1) == -24000);               // -0.06 m x 400000
+  CHECK(emulator.Position(1) == -24000);                                 // -0.06 m x 400000
   CHECK(emulator.Position(5) == std::lround(0.05 * 6400 * 180 / M_PI));  // sign -1 on the right pan
   // Outside a soft limit: refused before a byte is sent.
   const size_t sent = emulator.Received().size();
-  CHECK_THROWS_WITH(driver.MoveTo(Pose(-0.06, 0.7, 0, 0.06, 0, 0)), Catch::Contains("soft limits") && Catch::Contains("left pan"));
+  CHECK_THROWS_WITH(driver.MoveTo(Pose(-0.06, 0.7, 0, 0.06, 0, 0)),
+                    Catch::Contains("soft limits") && Catch::Contains("left pan"));
   CHECK(emulator.Received().size() == sent);
 }
 
-TEST_CASE("indexer driver: each injected fault is a clear error within twice the timeout, all axes killed", "[indexer]") {
+TEST_CASE(
+    "indexer driver: each injected fault is a clear error within twice the timeout, all axes "
+    "killed",
+    "[indexer]") {
   const auto timeout = std::chrono::milliseconds(300);
   struct Case {
     IndexerFault fault;
@@ -155,7 +163,8 @@ TEST_CASE("indexer driver: a long random sequence of moves ends where commanded"
 }
 
 TEST_CASE("serial ports: a missing port and a wrong baud rate are one-line errors", "[indexer]") {
-  CHECK_THROWS_WITH(rig::OpenSerialPort("/dev/ttyNOPE0", 9600), Catch::Contains("/dev/ttyNOPE0") && Catch::Contains("does not exist"));
+  CHECK_THROWS_WITH(rig::OpenSerialPort("/dev/ttyNOPE0", 9600),
+                    Catch::Contains("/dev/ttyNOPE0") && Catch::Contains("does not exist"));
   CHECK_THROWS_WITH(rig::OpenSerialPort("/dev/null", 12345), Catch::Contains("baud rate 12345"));
 }
 
@@ -180,7 +189,8 @@ TEST_CASE("indexer driver: SIGTERM and a driver destroyed mid-move kill every ax
   CHECK(WIFSIGNALED(status));
   CHECK(WTERMSIG(status) == SIGTERM);
   const auto deadline = Clock::now() + std::chrono::seconds(2);
-  while (emulator.Kills(6) == 0 && Clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  while (emulator.Kills(6) == 0 && Clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
   for (const int u : kUnits) {
     CHECK(emulator.Kills(u) == 1);
     CHECK_FALSE(emulator.Moving(u));
@@ -194,7 +204,8 @@ TEST_CASE("indexer driver: SIGTERM and a driver destroyed mid-move kill every ax
   for (const int u : kUnits) CHECK(emulator.Kills(u) == 2);
 }
 
-TEST_CASE("indexer replies: framing, position and status parsed or refused, never misread", "[indexer]") {
+TEST_CASE("indexer replies: framing, position and status parsed or refused, never misread",
+          "[indexer]") {
   const rig::IndexerDialect& d = rig::IndexerDialect::Compumotor6k();
   using R = rig::IndexerDialect::Reply;
   CHECK(d.ParseReply("").status == R::kIncomplete);

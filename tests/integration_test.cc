@@ -1,7 +1,8 @@
 // Integration: the hierarchical replacement rule, judged in the current view.
+#include "fovea/integration.h"
+
 #include <catch2/catch.hpp>
 
-#include "fovea/integration.h"
 #include "test_views.h"
 
 namespace {
@@ -16,8 +17,8 @@ fovea::PatchMap Grid(int n, double h, double y, fovea::PatchLevel level, int res
     for (int j = 0; j < n; ++j) {
       fovea::Patch p;
       const double x0 = -h + i * s, z0 = -h + j * s;
-      p.corners_W = {Eigen::Vector3d(x0, y, z0), Eigen::Vector3d(x0 + s, y, z0), Eigen::Vector3d(x0 + s, y, z0 + s),
-                     Eigen::Vector3d(x0, y, z0 + s)};
+      p.corners_W = {Eigen::Vector3d(x0, y, z0), Eigen::Vector3d(x0 + s, y, z0),
+                     Eigen::Vector3d(x0 + s, y, z0 + s), Eigen::Vector3d(x0, y, z0 + s)};
       p.level = level;
       p.resolution_level = resolution;
       map.Add(p);
@@ -27,7 +28,8 @@ fovea::PatchMap Grid(int n, double h, double y, fovea::PatchLevel level, int res
 
 }  // namespace
 
-TEST_CASE("foveal patches replace the coarser patches they cover, and only those", "[fovea][integration]") {
+TEST_CASE("foveal patches replace the coarser patches they cover, and only those",
+          "[fovea][integration]") {
   const rig::CameraView view = View();
   fovea::PatchMap map = Grid(10, 0.5, 1.0, fovea::PatchLevel::kIdr);  // 10 cm patches
   // Foveal patches over the central 20 x 20 cm: exactly 4 IDR patches.
@@ -50,11 +52,13 @@ TEST_CASE("peripheral data never replaces foveal data", "[fovea][integration]") 
   CHECK(stats.replaced[2] == 0);
   CHECK(map.CountByLevel() == std::array<int, 3>{0, 24, 64});
   // Peripheral replaces peripheral of the same or coarser resolution...
-  const auto again = fovea::Integrate(&map, Grid(5, 0.5, 1.0, fovea::PatchLevel::kPeripheral, 1), view);
+  const auto again =
+      fovea::Integrate(&map, Grid(5, 0.5, 1.0, fovea::PatchLevel::kPeripheral, 1), view);
   CHECK(again.replaced[1] == 24);
   CHECK(map.CountByLevel() == std::array<int, 3>{0, 24, 64});
   // ...but a coarser resolution does not replace a finer one.
-  const auto coarser = fovea::Integrate(&map, Grid(5, 0.5, 1.0, fovea::PatchLevel::kPeripheral, 3), view);
+  const auto coarser =
+      fovea::Integrate(&map, Grid(5, 0.5, 1.0, fovea::PatchLevel::kPeripheral, 3), view);
   CHECK(coarser.added == 0);
   CHECK(coarser.dropped_under_finer == 25);
 }

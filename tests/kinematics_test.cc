@@ -1,7 +1,7 @@
+#include "rig/kinematics.h"
+
 #include <catch2/catch.hpp>
 #include <cmath>
-
-#include "rig/kinematics.h"
 
 namespace {
 rig::RigGeometry Geometry() {

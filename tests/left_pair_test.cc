@@ -1,12 +1,14 @@
 // The left camera paired with itself at two carriage positions, on the
 // simulated rig (noise off).
+#include "rig/left_pair.h"
+
 #include <catch2/catch.hpp>
 #include <opencv2/core.hpp>
 
-#include "rig/left_pair.h"
 #include "scenes/catalog.h"
 
-TEST_CASE("left camera pair: two grabs of the left camera, the right camera left alone", "[rig][left_pair][slow]") {
+TEST_CASE("left camera pair: two grabs of the left camera, the right camera left alone",
+          "[rig][left_pair][slow]") {
   auto sim = scenes::LoadScene("fronto_planes", {});
   rig::Rig& rig = sim->rig();
   rig::LeftCameraPair pair(rig);
@@ -25,7 +27,8 @@ TEST_CASE("left camera pair: two grabs of the left camera, the right camera left
 
   // Each view was taken by the left head at its stage.
   for (rig::Side side : {rig::Side::kLeft, rig::Side::kRight}) {
-    const Eigen::Isometry3d expected = rig.Geometry().WorldFromCamera(rig::Side::kLeft, target[side]);
+    const Eigen::Isometry3d expected =
+        rig.Geometry().WorldFromCamera(rig::Side::kLeft, target[side]);
     CHECK((f[side].world_T_camera.translation() - expected.translation()).norm() < 1e-4);
     CHECK(f.state[side].baseline_m == Approx(target[side].baseline_m).margin(1e-5));
   }
@@ -39,7 +42,8 @@ TEST_CASE("left camera pair: two grabs of the left camera, the right camera left
   rig.MoveTo(there);
   const cv::Mat direct = rig.Capture().left.gray;
   CHECK(cv::norm(direct, f.right.gray, cv::NORM_L1) / double(direct.total()) < 0.5);
-  CHECK(cv::norm(f.left.gray, f.right.gray, cv::NORM_L1) / double(direct.total()) > 5);  // 6 cm of parallax
+  CHECK(cv::norm(f.left.gray, f.right.gray, cv::NORM_L1) / double(direct.total()) >
+        5);  // 6 cm of parallax
 
   // A stage the left carriage cannot reach is refused before anything moves.
   rig::StageState bad = target;

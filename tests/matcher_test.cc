@@ -1,8 +1,9 @@
+#include "fovea/matcher.h"
+
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
-#include "fovea/matcher.h"
 #include "fovea/sgbm.h"
 
 namespace {
@@ -54,7 +55,8 @@ TEST_CASE("NL1 matching recovers signed sub-pixel disparities", "[fovea][matcher
   }
 }
 
-TEST_CASE("NL1 matching: ranges bound the search, texture and left-right checks reject", "[fovea][matcher]") {
+TEST_CASE("NL1 matching: ranges bound the search, texture and left-right checks reject",
+          "[fovea][matcher]") {
   const cv::Mat left = Texture(80, 120, 9);
   const cv::Mat right = Shift(left, 5);
   const fovea::Nl1Matcher matcher;
@@ -71,7 +73,8 @@ TEST_CASE("NL1 matching: ranges bound the search, texture and left-right checks 
       if (std::isfinite(m)) REQUIRE((m >= -4.5f && m <= 2.5f));
     }
   // lo > hi: the pixel is not searched.
-  const cv::Mat skip_lo(left.size(), CV_32F, cv::Scalar(1)), skip_hi(left.size(), CV_32F, cv::Scalar(0));
+  const cv::Mat skip_lo(left.size(), CV_32F, cv::Scalar(1)),
+      skip_hi(left.size(), CV_32F, cv::Scalar(0));
   CHECK(matcher.Match(left, right, skip_lo, skip_hi).searched == 0);
   // A flat image has no texture to match.
   const cv::Mat flat(left.size(), CV_8U, cv::Scalar(100));
@@ -92,7 +95,8 @@ TEST_CASE("SGBM plugs into the same interface and finds the same disparity", "[f
     std::vector<double> errs;
     for (int y = 10; y < 110; ++y)
       for (int x = 40; x < 160; ++x)
-        if (std::isfinite(r.disparity_px.at<float>(y, x))) errs.push_back(std::abs(r.disparity_px.at<float>(y, x) - d));
+        if (std::isfinite(r.disparity_px.at<float>(y, x)))
+          errs.push_back(std::abs(r.disparity_px.at<float>(y, x) - d));
     REQUIRE(errs.size() > 0.8 * 100 * 120);
     std::nth_element(errs.begin(), errs.begin() + errs.size() / 2, errs.end());
     CHECK(errs[errs.size() / 2] < 0.2);

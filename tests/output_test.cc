@@ -2,20 +2,21 @@
 // empty, or replaced only when fovea wrote it and --force says so; results
 // appear whole under the target's name or not at all; nothing else is
 // touched.
+#include "output.h"
+
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
 
-#include "output.h"
-
 namespace fs = std::filesystem;
 
 namespace {
 
 fs::path FreshDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("fovea_output_test_" + name + "_" + std::to_string(getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("fovea_output_test_" + name + "_" + std::to_string(getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
@@ -35,7 +36,8 @@ TEST_CASE("output paths are normalized, and the folders above refused", "[output
   CHECK(NormalizeOutputPath("/tmp/x/../y", "--out") == "/tmp/y");
   for (const char* bad : {"", ".", "./", "..", "../", "/", "out/.."})
     CHECK_THROWS_AS(NormalizeOutputPath(bad, "--out"), experiments::UsageError);
-  CHECK_THROWS_WITH(NormalizeOutputPath(std::string(300, 'x'), "--out"), Catch::Contains("too long"));
+  CHECK_THROWS_WITH(NormalizeOutputPath(std::string(300, 'x'), "--out"),
+                    Catch::Contains("too long"));
 }
 
 TEST_CASE("an output folder appears whole on Commit, and nothing without it", "[output]") {
@@ -60,7 +62,8 @@ TEST_CASE("an output folder appears whole on Commit, and nothing without it", "[
   fs::remove_all(dir);
 }
 
-TEST_CASE("existing targets: refused, or replaced with --force only when fovea wrote them", "[output]") {
+TEST_CASE("existing targets: refused, or replaced with --force only when fovea wrote them",
+          "[output]") {
   const fs::path dir = FreshDir("existing");
   using experiments::ExistingOutput;
   using experiments::OutputFolder;
@@ -114,10 +117,13 @@ TEST_CASE("staging folders of processes that are gone are removed, live ones kep
 TEST_CASE("a one-file output refuses what exists unless --force, and never a folder", "[output]") {
   const fs::path dir = FreshDir("file");
   std::ofstream(dir / "calibration.yaml") << "old";
-  CHECK(experiments::CheckOutputFile((dir / "new.yaml").string(), "--out", false) == (dir / "new.yaml").string());
-  CHECK_THROWS_WITH(experiments::CheckOutputFile((dir / "calibration.yaml").string(), "--out", false),
-                    Catch::Contains("pass --force"));
+  CHECK(experiments::CheckOutputFile((dir / "new.yaml").string(), "--out", false) ==
+        (dir / "new.yaml").string());
+  CHECK_THROWS_WITH(
+      experiments::CheckOutputFile((dir / "calibration.yaml").string(), "--out", false),
+      Catch::Contains("pass --force"));
   CHECK_NOTHROW(experiments::CheckOutputFile((dir / "calibration.yaml").string(), "--out", true));
-  CHECK_THROWS_WITH(experiments::CheckOutputFile(dir.string(), "--out", true), Catch::Contains("not a file"));
+  CHECK_THROWS_WITH(experiments::CheckOutputFile(dir.string(), "--out", true),
+                    Catch::Contains("not a file"));
   fs::remove_all(dir);
 }

@@ -24,8 +24,8 @@ fovea::Patch RandomPatch(std::mt19937_64& rng) {
 
 fovea::Patch Square(double y, double half, fovea::PatchLevel level) {
   fovea::Patch p;
-  p.corners_W = {Eigen::Vector3d(-half, y, -half), Eigen::Vector3d(half, y, -half), Eigen::Vector3d(half, y, half),
-                 Eigen::Vector3d(-half, y, half)};
+  p.corners_W = {Eigen::Vector3d(-half, y, -half), Eigen::Vector3d(half, y, -half),
+                 Eigen::Vector3d(half, y, half), Eigen::Vector3d(-half, y, half)};
   p.level = level;
   return p;
 }
@@ -58,13 +58,15 @@ TEST_CASE("the map's index answers ray queries exactly as testing every patch", 
   REQUIRE(map.size() == 2500);
   for (int i = 0; i < 500; ++i) {
     const Eigen::Vector3d d = Eigen::Vector3d(dir(rng), 1, dir(rng)).normalized();
-    const auto a = map.CastRay(Eigen::Vector3d::Zero(), d), b = map.CastRayBruteForce(Eigen::Vector3d::Zero(), d);
+    const auto a = map.CastRay(Eigen::Vector3d::Zero(), d),
+               b = map.CastRayBruteForce(Eigen::Vector3d::Zero(), d);
     REQUIRE(a.has_value() == b.has_value());
     if (a) CHECK(a->patch == b->patch);
   }
 }
 
-TEST_CASE("rendering shows the finer level where patches of one surface overlap", "[fovea][patch]") {
+TEST_CASE("rendering shows the finer level where patches of one surface overlap",
+          "[fovea][patch]") {
   rig::CameraIntrinsics k;
   k.width_px = 64;
   k.height_px = 48;
@@ -75,13 +77,14 @@ TEST_CASE("rendering shows the finer level where patches of one surface overlap"
   Eigen::Isometry3d world_T_camera = Eigen::Isometry3d::Identity();
   world_T_camera.linear() << 1, 0, 0, 0, 0, 1, 0, -1, 0;
   fovea::PatchMap map;
-  map.Add(Square(1.000, 0.5, fovea::PatchLevel::kIdr));        // slightly nearer, coarser
-  map.Add(Square(1.005, 0.1, fovea::PatchLevel::kFoveal));     // same surface within 2%
-  map.Add(Square(2.000, 0.9, fovea::PatchLevel::kFoveal));     // a different surface behind
+  map.Add(Square(1.000, 0.5, fovea::PatchLevel::kIdr));     // slightly nearer, coarser
+  map.Add(Square(1.005, 0.1, fovea::PatchLevel::kFoveal));  // same surface within 2%
+  map.Add(Square(2.000, 0.9, fovea::PatchLevel::kFoveal));  // a different surface behind
   cv::Mat depth, ids;
   map.Render(world_T_camera, k, &depth, &ids);
   CHECK(ids.at<int>(24, 32) == 1);  // centre: the foveal patch wins over the nearer IDR one
   CHECK(depth.at<float>(24, 32) == Approx(1.005).epsilon(1e-4));
-  CHECK(ids.at<int>(24, 5) == 0);   // outside the small patch: the IDR one, nearer than the far plane
+  CHECK(ids.at<int>(24, 5) ==
+        0);  // outside the small patch: the IDR one, nearer than the far plane
   CHECK(map.CountByLevel() == std::array<int, 3>{1, 0, 2});
 }

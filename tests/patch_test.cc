@@ -1,14 +1,15 @@
+#include "fovea/patch.h"
+
 #include <catch2/catch.hpp>
 #include <cmath>
-
-#include "fovea/patch.h"
 
 namespace {
 std::vector<fovea::DisparitySample> PlaneSamples(double a, double b, double c, double x0, double y0,
                                                  int size, int step) {
   std::vector<fovea::DisparitySample> s;
   for (int y = 0; y < size; y += step)
-    for (int x = 0; x < size; x += step) s.push_back({x0 + x + 0.3, y0 + y, a * (x0 + x + 0.3) + b * (y0 + y) + c});
+    for (int x = 0; x < size; x += step)
+      s.push_back({x0 + x + 0.3, y0 + y, a * (x0 + x + 0.3) + b * (y0 + y) + c});
   return s;
 }
 fovea::Patch Square(double z, double half) {
@@ -96,8 +97,10 @@ TEST_CASE("patch map: rendering into a view gives depth and patch ids", "[fovea]
   // Agrees with ray casting everywhere it is set.
   for (int v = 0; v < 150; v += 10)
     for (int x = 0; x < 200; x += 10) {
-      const auto hit = map.CastRay(Eigen::Vector3d::Zero(), k.Ray({double(x), double(v)}).normalized());
+      const auto hit =
+          map.CastRay(Eigen::Vector3d::Zero(), k.Ray({double(x), double(v)}).normalized());
       if (!hit) continue;
-      CHECK(depth.at<float>(v, x) == Approx(hit->distance_m / k.Ray({double(x), double(v)}).norm()).epsilon(1e-5));
+      CHECK(depth.at<float>(v, x) ==
+            Approx(hit->distance_m / k.Ray({double(x), double(v)}).norm()).epsilon(1e-5));
     }
 }

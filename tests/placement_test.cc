@@ -1,11 +1,13 @@
+#include "fovea/placement.h"
+
 #include <catch2/catch.hpp>
 #include <cmath>
 
-#include "fovea/placement.h"
 #include "test_rig.h"
 
 namespace {
-const rig::CameraIntrinsics kCamera = rig::CameraIntrinsics::FromHorizontalFov(640, 480, 30 * M_PI / 180);
+const rig::CameraIntrinsics kCamera =
+    rig::CameraIntrinsics::FromHorizontalFov(640, 480, 30 * M_PI / 180);
 constexpr double kBaseline = 0.06;
 
 // The simulator's default rig, home pose 0.10 m wide.
@@ -22,23 +24,29 @@ fovea::PlacementRig TestRig(bool left_pair = true) {
 // A square facing the rig (normal along world y), `half` metres to each side of centre_W.
 fovea::Patch Square(const Eigen::Vector3d& centre_W, double half) {
   fovea::Patch p;
-  p.corners_W = {centre_W + Eigen::Vector3d(-half, 0, -half), centre_W + Eigen::Vector3d(half, 0, -half),
-                 centre_W + Eigen::Vector3d(half, 0, half), centre_W + Eigen::Vector3d(-half, 0, half)};
+  p.corners_W = {
+      centre_W + Eigen::Vector3d(-half, 0, -half), centre_W + Eigen::Vector3d(half, 0, -half),
+      centre_W + Eigen::Vector3d(half, 0, half), centre_W + Eigen::Vector3d(-half, 0, half)};
   return p;
 }
 
 fovea::PlacementChoice Choose(const fovea::PatchMap& map, const Eigen::Vector3d& p_W,
-                              const std::optional<fovea::DepthRange>& guessed = std::nullopt, bool left_pair = true) {
+                              const std::optional<fovea::DepthRange>& guessed = std::nullopt,
+                              bool left_pair = true) {
   return fovea::ChoosePlacement(TestRig(left_pair), map, p_W, kBaseline, {}, guessed);
 }
 
 // The optical centre of one camera of the pair the choice uses.
 Eigen::Vector3d OpticalCentre(const fovea::PlacementChoice& c, rig::Side side) {
-  return TestRig().For(c.placement).geometry.WorldFromCamera(side, c.vergence.state[side]).translation();
+  return TestRig()
+      .For(c.placement)
+      .geometry.WorldFromCamera(side, c.vergence.state[side])
+      .translation();
 }
 }  // namespace
 
-TEST_CASE("carriage placements keep the baseline and put the named carriage innermost", "[fovea][placement]") {
+TEST_CASE("carriage placements keep the baseline and put the named carriage innermost",
+          "[fovea][placement]") {
   const fovea::PlacementRig l = TestRig();
   using fovea::Placement;
   const rig::StageState sym = fovea::PlaceCarriages(l, kBaseline, Placement::kSymmetric);
@@ -60,7 +68,8 @@ TEST_CASE("carriage placements keep the baseline and put the named carriage inne
   CHECK(std::string(fovea::PlacementName(Placement::kRightInner)) == "right_inner");
 }
 
-TEST_CASE("placement: the right carriage innermost unless the map hides the point from it", "[fovea][placement]") {
+TEST_CASE("placement: the right carriage innermost unless the map hides the point from it",
+          "[fovea][placement]") {
   const Eigen::Vector3d p(0.0, 1.2, 0.0);
   fovea::PatchMap map;
   map.Add(Square(p, 0.2));  // the surface the point lies on
@@ -108,14 +117,17 @@ TEST_CASE("placement: a guessed depth also weighs the points behind it", "[fovea
   CHECK(Choose(map, p, fovea::DepthRange{0.4, 0.9}).occluded == 0);
 }
 
-TEST_CASE("placement: a point no placement can fixate is reported, with why", "[fovea][placement]") {
+TEST_CASE("placement: a point no placement can fixate is reported, with why",
+          "[fovea][placement]") {
   const fovea::PlacementChoice behind = Choose({}, {0.0, -1.0, 0.0});
   CHECK_FALSE(behind.vergence.ok);
   CHECK_FALSE(behind.vergence.why.empty());
 }
 
-TEST_CASE("placement: past a near left edge, where no right camera sees, the left camera pairs with itself",
-          "[fovea][placement]") {
+TEST_CASE(
+    "placement: past a near left edge, where no right camera sees, the left camera pairs with "
+    "itself",
+    "[fovea][placement]") {
   // A block face at 0.5 m whose left edge is at x = -0.07, and the plane at
   // 1.2 m: the point just left of the edge (seen from the home pose's left
   // camera at x = -0.05) is hidden from every right camera position (x >=
@@ -137,7 +149,8 @@ TEST_CASE("placement: past a near left edge, where no right camera sees, the lef
   CHECK(with.vergence.state.right.baseline_m == Approx(-0.05).margin(1e-5));
   // Both of its "cameras" are the left head: on the point's line of sight
   // from either stage.
-  const Eigen::Vector3d a = OpticalCentre(with, rig::Side::kLeft), b = OpticalCentre(with, rig::Side::kRight);
+  const Eigen::Vector3d a = OpticalCentre(with, rig::Side::kLeft),
+                        b = OpticalCentre(with, rig::Side::kRight);
   CHECK(a.x() < b.x());
   CHECK(b.x() < -0.04);
 }

@@ -24,8 +24,8 @@ TEST_CASE("projection and back-projection are inverse, with and without distorti
   auto k = rig::CameraIntrinsics::FromHorizontalFov(640, 480, 0.6);
   for (bool distorted : {false, true}) {
     if (distorted) k.distortion = {-0.12, 0.05, 0.001, -0.0005, 0.0};
-    for (const Eigen::Vector3d& p : {Eigen::Vector3d(0.1, -0.05, 1.2), Eigen::Vector3d(-0.2, 0.1, 0.8),
-                                     Eigen::Vector3d(0, 0, 2)}) {
+    for (const Eigen::Vector3d& p : {Eigen::Vector3d(0.1, -0.05, 1.2),
+                                     Eigen::Vector3d(-0.2, 0.1, 0.8), Eigen::Vector3d(0, 0, 2)}) {
       const Eigen::Vector2d uv = k.Project(p);
       const Eigen::Vector3d ray = k.Ray(uv);
       CHECK((ray * p.z() - p).norm() < 1e-9);

@@ -1,7 +1,8 @@
 // Ground-truth scoring's reference view.
+#include "run_eval.h"
+
 #include <catch2/catch.hpp>
 
-#include "run_eval.h"
 #include "scenes/catalog.h"
 
 TEST_CASE("reference view: the strip past a near left edge is out of every right camera's sight",

@@ -1,9 +1,10 @@
 // Fixation selection: normalized criteria, their product, the exponential
 // draw, the deterministic mode, refused points.
+#include "fovea/selection.h"
+
 #include <catch2/catch.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "fovea/selection.h"
 #include "test_views.h"
 
 namespace {
@@ -50,12 +51,14 @@ TEST_CASE("each criterion is normalized and says what it should", "[fovea][selec
   const fovea::Proximity2D p2d(40);
   const fovea::Proximity3D p3d(0.1);
   CHECK(gradient.Evaluate(c).at<double>(60, 120) > 20 * gradient.Evaluate(c).at<double>(60, 30));
-  CHECK(suppression.Evaluate(c).at<double>(60, 120) == Approx(50 * suppression.Evaluate(c).at<double>(60, 30)));
+  CHECK(suppression.Evaluate(c).at<double>(60, 120) ==
+        Approx(50 * suppression.Evaluate(c).at<double>(60, 30)));
   CHECK(p2d.Evaluate(c).at<double>(60, 80) > p2d.Evaluate(c).at<double>(5, 5));
   CHECK(p3d.Evaluate(c).at<double>(60, 30) == Approx(10 * p3d.Evaluate(c).at<double>(60, 120)));
 }
 
-TEST_CASE("the exponential draw favours high values with the scale asked for", "[fovea][selection]") {
+TEST_CASE("the exponential draw favours high values with the scale asked for",
+          "[fovea][selection]") {
   CHECK(fovea::DrawExponential(0.0, 0.5) == 0.0);
   CHECK(fovea::DrawExponential(1.0 - 1e-12, 0.5) == Approx(1.0).margin(1e-6));
   // Mean of u under density ~ exp(-u / s) on [0, 1], s = 0.5: s - e^(-1/s) / (1 - e^(-1/s)).
@@ -67,7 +70,8 @@ TEST_CASE("the exponential draw favours high values with the scale asked for", "
   CHECK(fovea::DrawExponential(0.5, 0.1) < fovea::DrawExponential(0.5, 0.5));
 }
 
-TEST_CASE("selection: deterministic takes the maximum, and draws are reproducible from the seed", "[fovea][selection]") {
+TEST_CASE("selection: deterministic takes the maximum, and draws are reproducible from the seed",
+          "[fovea][selection]") {
   fovea::PatchMap map;
   map.Add(Square(-1, 0, -1, 1, 1.0, fovea::PatchLevel::kFoveal));
   map.Add(Square(0, 1, -1, 1, 1.0, fovea::PatchLevel::kIdr));
@@ -79,7 +83,7 @@ TEST_CASE("selection: deterministic takes the maximum, and draws are reproducibl
   const auto s = det.Choose(c, map, {}, &rng);
   REQUIRE(s.ok);
   CHECK(s.composite_chosen == s.composite_max);
-  CHECK(s.pixel.x() >= 80);                       // on the texture, not the foveal half
+  CHECK(s.pixel.x() >= 80);                          // on the texture, not the foveal half
   CHECK(s.point_W.y() == Approx(1.0).margin(1e-9));  // raytraced into the map
 
   o.deterministic = false;
@@ -100,7 +104,8 @@ TEST_CASE("selection: deterministic takes the maximum, and draws are reproducibl
   CHECK((refused.point_W - s.point_W).norm() >= o.refused_radius_m);
 }
 
-TEST_CASE("graded suppression: peripheral data weighs between foveal data and the rest", "[fovea][selection]") {
+TEST_CASE("graded suppression: peripheral data weighs between foveal data and the rest",
+          "[fovea][selection]") {
   fovea::PatchMap map;
   map.Add(Square(-1, -0.3, -1, 1, 1.0, fovea::PatchLevel::kFoveal));
   map.Add(Square(-0.3, 0.3, -1, 1, 1.0, fovea::PatchLevel::kPeripheral));
@@ -115,7 +120,8 @@ TEST_CASE("graded suppression: peripheral data weighs between foveal data and th
   CHECK(paper.at<double>(60, 80) == Approx(paper.at<double>(60, 150)));
 }
 
-TEST_CASE("local suppression: zero weight at earlier fixations, low weight around them", "[fovea][selection]") {
+TEST_CASE("local suppression: zero weight at earlier fixations, low weight around them",
+          "[fovea][selection]") {
   fovea::PatchMap map;
   map.Add(Square(-1, 0, -1, 1, 1.0, fovea::PatchLevel::kFoveal));  // left half foveal, 1 m
   map.Add(Square(0, 1, -1, 1, 1.0, fovea::PatchLevel::kIdr));      // right half IDR, 1 m
@@ -125,20 +131,21 @@ TEST_CASE("local suppression: zero weight at earlier fixations, low weight aroun
   const cv::Mat w = fovea::LocalSuppression(0.02, 0.08, 0.3, 0.03).Evaluate(c);
   const double free = w.at<double>(60, 150);  // 0.2 m from the nearest fixation
   REQUIRE(free > 0);
-  CHECK(w.at<double>(60, 120) == 0.0);                        // on the IDR fixation point
-  CHECK(w.at<double>(60, 123) == 0.0);                        // 2 cm away
-  CHECK(w.at<double>(60, 126) == Approx(0.02 * free));        // 4 cm away: within the radius
-  CHECK(w.at<double>(60, 40) == 0.0);                         // foveal data is 0 at a fixation too
-  CHECK(w.at<double>(60, 10) == Approx(0.02 * free));         // and 0.02 elsewhere
+  CHECK(w.at<double>(60, 120) == 0.0);                  // on the IDR fixation point
+  CHECK(w.at<double>(60, 123) == 0.0);                  // 2 cm away
+  CHECK(w.at<double>(60, 126) == Approx(0.02 * free));  // 4 cm away: within the radius
+  CHECK(w.at<double>(60, 40) == 0.0);                   // foveal data is 0 at a fixation too
+  CHECK(w.at<double>(60, 10) == Approx(0.02 * free));   // and 0.02 elsewhere
   // Without a revisit radius the fixation point itself keeps the low weight.
   const cv::Mat paper = fovea::LocalSuppression(0.02, 0.08, 0.3, 0.0).Evaluate(c);
   CHECK(paper.at<double>(60, 120) == Approx(0.02 * paper.at<double>(60, 150)));
 }
 
-TEST_CASE("holes in the map take the nearest mapped depth and can be fixated", "[fovea][selection]") {
+TEST_CASE("holes in the map take the nearest mapped depth and can be fixated",
+          "[fovea][selection]") {
   fovea::PatchMap map;
   map.Add(Square(-1, 0, -1, 1, 2.0, fovea::PatchLevel::kPeripheral));  // left half only, 2 m
-  const cv::Mat image = HalfTextured();                                 // texture on the right: the hole
+  const cv::Mat image = HalfTextured();  // texture on the right: the hole
   const fovea::SelectionContext plain = fovea::SelectionContext::Make(image, View(), map);
   const fovea::SelectionContext filled = fovea::SelectionContext::Make(image, View(), map, true);
   CHECK(plain.map_depth_m.at<float>(60, 120) == 0.f);

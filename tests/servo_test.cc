@@ -1,4 +1,6 @@
 // Visual servoing on the simulated rig, noise on.
+#include "fovea/servo.h"
+
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <memory>
@@ -6,7 +8,6 @@
 
 #include "fovea/foveal.h"
 #include "fovea/geometry.h"
-#include "fovea/servo.h"
 #include "fovea/vergence.h"
 #include "scenes/catalog.h"
 
@@ -29,9 +30,11 @@ std::string Residuals(const fovea::ServoResult& r) {
 // A point on the left camera's axis as it fixates p_W, `scale` times as far
 // from the camera: fixating it points the left camera at p_W again, with the
 // depth guessed wrong.
-Eigen::Vector3d OnLeftAxis(rig::Rig& rig, const Eigen::Vector3d& p_W, double scale, double baseline_m) {
-  const auto sol = fovea::Verge(rig.Geometry(), rig.Limits(), rig.Intrinsics(rig::Side::kLeft),
-                                rig.Intrinsics(rig::Side::kRight), rig::StageState::Parallel(baseline_m), p_W);
+Eigen::Vector3d OnLeftAxis(rig::Rig& rig, const Eigen::Vector3d& p_W, double scale,
+                           double baseline_m) {
+  const auto sol =
+      fovea::Verge(rig.Geometry(), rig.Limits(), rig.Intrinsics(rig::Side::kLeft),
+                   rig.Intrinsics(rig::Side::kRight), rig::StageState::Parallel(baseline_m), p_W);
   REQUIRE(sol.ok);
   rig.MoveTo(sol.state);
   const Eigen::Vector3d c = rig.Capture().left.world_T_camera.translation();
@@ -48,18 +51,17 @@ TEST_CASE("servoing converges from 20 px off within 6 steps", "[fovea][servo][sl
     std::string scene;
     Eigen::Vector3d p_W;
   };
-  const std::vector<Point> points = {{"cylinder_planes", {0.0, 0.89, 0.0}},
-                                     {"cylinder_planes", {-0.2, 0.93, 0.05}},
-                                     {"cylinder_planes", {0.25, 1.0, -0.05}},
-                                     {"three_surfaces", {-0.05, 0.53, -0.055}},
-                                     {"three_surfaces", {0.09, 0.86, 0.05}},
-                                     {"three_surfaces", {-0.25, 1.2, 0.1}}};
+  const std::vector<Point> points = {
+      {"cylinder_planes", {0.0, 0.89, 0.0}},   {"cylinder_planes", {-0.2, 0.93, 0.05}},
+      {"cylinder_planes", {0.25, 1.0, -0.05}}, {"three_surfaces", {-0.05, 0.53, -0.055}},
+      {"three_surfaces", {0.09, 0.86, 0.05}},  {"three_surfaces", {-0.25, 1.2, 0.1}}};
   for (const Point& pt : points) {
     INFO(pt.scene << " " << pt.p_W.transpose());
     auto sim = NoisyScene(pt.scene);
     rig::Rig& rig = sim->rig();
-    const auto sol = fovea::Verge(rig.Geometry(), rig.Limits(), rig.Intrinsics(rig::Side::kLeft),
-                                  rig.Intrinsics(rig::Side::kRight), rig::StageState::Parallel(0.12), pt.p_W);
+    const auto sol =
+        fovea::Verge(rig.Geometry(), rig.Limits(), rig.Intrinsics(rig::Side::kLeft),
+                     rig.Intrinsics(rig::Side::kRight), rig::StageState::Parallel(0.12), pt.p_W);
     REQUIRE(sol.ok);
     rig::StageState start = sol.state;
     const double f = rig.Intrinsics(rig::Side::kRight).fx_px;
@@ -74,7 +76,8 @@ TEST_CASE("servoing converges from 20 px off within 6 steps", "[fovea][servo][sl
   }
 }
 
-TEST_CASE("a guessed depth: the servo searches every depth and finds the surface", "[fovea][servo][slow]") {
+TEST_CASE("a guessed depth: the servo searches every depth and finds the surface",
+          "[fovea][servo][slow]") {
   auto sim = NoisyScene("three_surfaces");
   rig::Rig& rig = sim->rig();
   const fovea::Nl1Matcher matcher;
@@ -100,7 +103,8 @@ TEST_CASE("a guessed depth: the servo searches every depth and finds the surface
   CHECK((narrow.fixation_W - block).norm() > 0.1);
 }
 
-TEST_CASE("a guessed depth on a periodic texture: no unique match, the point is refused", "[fovea][servo][slow]") {
+TEST_CASE("a guessed depth on a periodic texture: no unique match, the point is refused",
+          "[fovea][servo][slow]") {
   auto sim = NoisyScene("periodic");
   rig::Rig& rig = sim->rig();
   const fovea::Nl1Matcher matcher;
@@ -116,8 +120,9 @@ TEST_CASE("a guessed depth on a periodic texture: no unique match, the point is 
   CHECK(r.foveal.patches.size() == 0);
 }
 
-TEST_CASE("a point the right camera cannot see: the servo's match is not mutual, the point is refused",
-          "[fovea][servo][slow]") {
+TEST_CASE(
+    "a point the right camera cannot see: the servo's match is not mutual, the point is refused",
+    "[fovea][servo][slow]") {
   auto sim = NoisyScene("three_surfaces");
   rig::Rig& rig = sim->rig();
   const fovea::Nl1Matcher matcher;
@@ -131,7 +136,8 @@ TEST_CASE("a point the right camera cannot see: the servo's match is not mutual,
   SECTION("without the check the servo settles on another surface") {
     o.servo.mutual_tolerance_px = 0;
     const fovea::FixationResult r = fovea::Fixate(rig, empty, hidden, matcher, o, 0);
-    INFO(r.why << " fixated at " << r.fixation_W.transpose() << ", residuals " << Residuals(r.servo));
+    INFO(r.why << " fixated at " << r.fixation_W.transpose() << ", residuals "
+               << Residuals(r.servo));
     CHECK(r.servo.mutual);
     CHECK_FALSE(r.servo.mutual_mismatch_px);
     // The reverse search finds the plywood's window far from the fabric's.
@@ -145,7 +151,8 @@ TEST_CASE("a point the right camera cannot see: the servo's match is not mutual,
     REQUIRE(o.servo.mutual_tolerance_px == 4.0);
     const fovea::FixationResult r = fovea::Fixate(rig, empty, hidden, matcher, o, 0);
     INFO(r.why << " fixated at " << r.fixation_W.transpose() << ", residuals " << Residuals(r.servo)
-                << ", mismatch " << (r.servo.mutual_mismatch_px ? *r.servo.mutual_mismatch_px : 0.0));
+               << ", mismatch "
+               << (r.servo.mutual_mismatch_px ? *r.servo.mutual_mismatch_px : 0.0));
     CHECK_FALSE(r.ok);
     CHECK_FALSE(r.servo.mutual);
     CHECK(r.why.find("mutual") != std::string::npos);
@@ -155,7 +162,8 @@ TEST_CASE("a point the right camera cannot see: the servo's match is not mutual,
     const Eigen::Vector3d open(-0.25, 1.2, 0.1);
     const fovea::FixationResult r = fovea::Fixate(rig, empty, open, matcher, o, 0);
     INFO(r.why << " fixated at " << r.fixation_W.transpose() << ", residual " << r.servo.residual_px
-                << ", mismatch " << (r.servo.mutual_mismatch_px ? *r.servo.mutual_mismatch_px : 99.0));
+               << ", mismatch "
+               << (r.servo.mutual_mismatch_px ? *r.servo.mutual_mismatch_px : 99.0));
     REQUIRE(r.ok);
     CHECK(r.servo.mutual);
     REQUIRE(r.servo.mutual_mismatch_px);

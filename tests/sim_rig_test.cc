@@ -1,5 +1,7 @@
 // The simulated TAVT: kinematics against MuJoCo, step quantization, settling,
 // rendering geometry, sensor noise. Noise is off unless a test turns it on.
+#include "sim/sim_rig.h"
+
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
@@ -11,7 +13,6 @@
 #include "fovea/geometry.h"
 #include "rig/kinematics.h"
 #include "scenes/catalog.h"
-#include "sim/sim_rig.h"
 #include "temp_scene.h"
 
 namespace {
@@ -21,20 +22,21 @@ constexpr double kDeg = M_PI / 180;
 // A user scene in a fresh temporary folder: a black wall 1.5 m away and small
 // white spheres at the given points.
 std::string WriteSphereScene(const std::vector<Eigen::Vector3d>& centres) {
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("fovea_sim_rig_test_" + std::to_string(getpid()));
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("fovea_sim_rig_test_" + std::to_string(getpid()));
   std::filesystem::create_directories(dir);
   const std::string path = (dir / "spheres.xml").string();
   std::ofstream out(path);
   out << "<mujoco>\n  <include file=\"tavt.xml\"/>\n"
-      << "  <asset><material name=\"white\" rgba=\"1 1 1 1\" specular=\"0\" emission=\"1\"/></asset>\n"
+      << "  <asset><material name=\"white\" rgba=\"1 1 1 1\" specular=\"0\" "
+         "emission=\"1\"/></asset>\n"
       << "  <worldbody>\n"
       << "    <light directional=\"true\" pos=\"0 0 3\" dir=\"0 0.5 -1\" diffuse=\"1 1 1\" "
          "specular=\"0 0 0\"/>\n"
       << "    <geom type=\"box\" size=\"2 0.01 2\" pos=\"0 1.5 0\" rgba=\"0 0 0 1\"/>\n";
   for (const auto& c : centres)
-    out << "    <geom type=\"sphere\" size=\"0.004\" pos=\"" << c.x() << " " << c.y() << " " << c.z()
-        << "\" material=\"white\"/>\n";
+    out << "    <geom type=\"sphere\" size=\"0.004\" pos=\"" << c.x() << " " << c.y() << " "
+        << c.z() << "\" material=\"white\"/>\n";
   out << "  </worldbody>\n</mujoco>\n";
   return path;
 }
@@ -43,8 +45,10 @@ std::string WriteSphereScene(const std::vector<Eigen::Vector3d>& centres) {
 Eigen::Vector2d BlobCentroid(const cv::Mat& gray, const Eigen::Vector2d& guess) {
   const int r = 15;
   double sw = 0, su = 0, sv = 0;
-  for (int v = std::max(0, int(guess.y()) - r); v <= std::min(gray.rows - 1, int(guess.y()) + r); ++v)
-    for (int u = std::max(0, int(guess.x()) - r); u <= std::min(gray.cols - 1, int(guess.x()) + r); ++u) {
+  for (int v = std::max(0, int(guess.y()) - r); v <= std::min(gray.rows - 1, int(guess.y()) + r);
+       ++v)
+    for (int u = std::max(0, int(guess.x()) - r); u <= std::min(gray.cols - 1, int(guess.x()) + r);
+         ++u) {
       const double w = gray.at<uchar>(v, u);
       if (w < 20) continue;
       sw += w;
@@ -67,7 +71,8 @@ TEST_CASE("camera poses from MuJoCo match the rig's forward kinematics", "[sim]"
   auto sim = scenes::LoadScene(PlaneScene().path(), sim::SimRigConfig{});
   rig::Rig& rig = sim->rig();
   for (const auto& target :
-       {rig.Home(), rig::StageState::FromArray({-0.2, 10 * kDeg, -5 * kDeg, 0.15, -20 * kDeg, 8 * kDeg}),
+       {rig.Home(),
+        rig::StageState::FromArray({-0.2, 10 * kDeg, -5 * kDeg, 0.15, -20 * kDeg, 8 * kDeg}),
         rig::StageState::FromArray({-0.001, -45 * kDeg, 25 * kDeg, 0.3, 55 * kDeg, -25 * kDeg})}) {
     rig.MoveTo(target);
     const rig::StereoFrame frame = rig.Capture();
@@ -134,7 +139,8 @@ TEST_CASE("a known 3D point renders where the camera model projects it", "[sim]"
   auto sim = scenes::LoadScene(path, sim::SimRigConfig{});
   rig::Rig& rig = sim->rig();
   for (const auto& target :
-       {rig.Home(), rig::StageState::FromArray({-0.08, -3 * kDeg, 2 * kDeg, 0.06, 4 * kDeg, -1.5 * kDeg})}) {
+       {rig.Home(),
+        rig::StageState::FromArray({-0.08, -3 * kDeg, 2 * kDeg, 0.06, 4 * kDeg, -1.5 * kDeg})}) {
     rig.MoveTo(target);
     const rig::StereoFrame frame = rig.Capture();
     for (rig::Side side : {rig::Side::kLeft, rig::Side::kRight}) {
@@ -142,8 +148,8 @@ TEST_CASE("a known 3D point renders where the camera model projects it", "[sim]"
       for (const auto& p : points) {
         const auto uv = fovea::ProjectWorldPoint(view.world_T_camera, view.intrinsics, p);
         REQUIRE(uv);
-        if (!view.intrinsics.InImage(*uv) || uv->x() < 20 || uv->y() < 20 ||
-            uv->x() > 620 || uv->y() > 460)
+        if (!view.intrinsics.InImage(*uv) || uv->x() < 20 || uv->y() < 20 || uv->x() > 620 ||
+            uv->y() > 460)
           continue;
         const Eigen::Vector2d seen = BlobCentroid(view.gray, *uv);
         INFO(rig::SideName(side) << " point " << p.transpose() << " predicted " << uv->transpose()

@@ -1,8 +1,9 @@
+#include "fovea/tessellation.h"
+
 #include <catch2/catch.hpp>
 #include <cmath>
 
 #include "fovea/geometry.h"
-#include "fovea/tessellation.h"
 #include "fovea/vergence.h"
 
 namespace {
@@ -31,8 +32,10 @@ Pair Verged(const Eigen::Vector3d& p_W, double b) {
 fovea::Patch FrontoPatch(const rig::CameraView& left, double z) {
   fovea::Patch p;
   const double h = 2.0;
-  p.corners_W = {left.world_T_camera * Eigen::Vector3d(-h, -h, z), left.world_T_camera * Eigen::Vector3d(h, -h, z),
-                 left.world_T_camera * Eigen::Vector3d(h, h, z), left.world_T_camera * Eigen::Vector3d(-h, h, z)};
+  p.corners_W = {left.world_T_camera * Eigen::Vector3d(-h, -h, z),
+                 left.world_T_camera * Eigen::Vector3d(h, -h, z),
+                 left.world_T_camera * Eigen::Vector3d(h, h, z),
+                 left.world_T_camera * Eigen::Vector3d(-h, h, z)};
   return p;
 }
 
@@ -41,13 +44,15 @@ fovea::Patch FrontoPatch(const rig::CameraView& left, double z) {
 double BruteVerticalDisparity(const Pair& pair, double z, int u, int v) {
   const auto& k = pair.left.intrinsics;
   const Eigen::Vector3d p_C((u - k.cx_px) / k.fx_px * z, (v - k.cy_px) / k.fy_px * z, z);
-  const auto uv = fovea::ProjectWorldPoint(pair.right.world_T_camera, k, pair.left.world_T_camera * p_C);
+  const auto uv =
+      fovea::ProjectWorldPoint(pair.right.world_T_camera, k, pair.left.world_T_camera * p_C);
   return std::abs(uv->y() - v);
 }
 
 }  // namespace
 
-TEST_CASE("tessellation of a fronto-parallel plane through the fixation point", "[fovea][tessellation]") {
+TEST_CASE("tessellation of a fronto-parallel plane through the fixation point",
+          "[fovea][tessellation]") {
   const Eigen::Vector3d fixation(0.05, 0.9, 0.02);
   const Pair pair = Verged(fixation, 0.12);
   const double z0 = (pair.left.world_T_camera.inverse() * fixation).z();
@@ -66,7 +71,7 @@ TEST_CASE("tessellation of a fronto-parallel plane through the fixation point", 
     for (int u = 0; u < k.width_px; ++u)
       if (BruteVerticalDisparity(pair, z0, u, v) >= 0.5)
         scale = std::min(scale, std::max(std::abs(u - k.cx_px) / (0.5 * k.width_px),
-                                          std::abs(v - k.cy_px) / (0.5 * k.height_px)));
+                                         std::abs(v - k.cy_px) / (0.5 * k.height_px)));
   const cv::Rect& fovea = t.rects[0];
   CHECK(fovea.width == Approx(scale * k.width_px).margin(2.0));
   CHECK(fovea.height == Approx(scale * k.height_px).margin(2.0));
@@ -76,7 +81,8 @@ TEST_CASE("tessellation of a fronto-parallel plane through the fixation point", 
     double worst = 0;
     const cv::Rect& r = t.rects[level];
     for (int v = r.y; v < r.y + r.height; v += 3)
-      for (int u = r.x; u < r.x + r.width; u += 3) worst = std::max(worst, BruteVerticalDisparity(pair, z0, u, v));
+      for (int u = r.x; u < r.x + r.width; u += 3)
+        worst = std::max(worst, BruteVerticalDisparity(pair, z0, u, v));
     INFO("level " << level << " rect " << r << " worst " << worst);
     if (level + 1 < t.rects.size()) CHECK(worst < 0.5 * std::pow(2.0, level));
     if (level > 0) CHECK((r & t.rects[level - 1]) == t.rects[level - 1]);  // nested
@@ -93,14 +99,16 @@ TEST_CASE("Z_T, Z_max and the depth mask follow the map", "[fovea][tessellation]
   const double d0 = fovea::AxisHorizontalDisparity(pair.left, pair.right, z0);
   CHECK(std::abs(fovea::AxisHorizontalDisparity(pair.left, pair.right, z0 + flat.z_t_far_m) - d0) ==
         Approx(0.5 * options.horizontal_disparity_limit_px).epsilon(1e-6));
-  CHECK(std::abs(fovea::AxisHorizontalDisparity(pair.left, pair.right, z0 - flat.z_t_near_m) - d0) ==
-        Approx(0.5 * options.horizontal_disparity_limit_px).epsilon(1e-6));
+  CHECK(std::abs(fovea::AxisHorizontalDisparity(pair.left, pair.right, z0 - flat.z_t_near_m) -
+                 d0) == Approx(0.5 * options.horizontal_disparity_limit_px).epsilon(1e-6));
   CHECK(flat.z_t_near_m < flat.z_t_far_m);  // disparity changes faster in front
   // A map with a surface 2 cm behind, and one far beyond Z_T.
   fovea::PatchMap map;
   fovea::Patch behind = FrontoPatch(pair.left, z0 + 0.02);
-  for (auto& c : behind.corners_W) c = pair.left.world_T_camera * Eigen::Vector3d(
-      (pair.left.world_T_camera.inverse() * c).x() > 0 ? 0.3 : 0.0, (pair.left.world_T_camera.inverse() * c).y(), z0 + 0.02);
+  for (auto& c : behind.corners_W)
+    c = pair.left.world_T_camera *
+        Eigen::Vector3d((pair.left.world_T_camera.inverse() * c).x() > 0 ? 0.3 : 0.0,
+                        (pair.left.world_T_camera.inverse() * c).y(), z0 + 0.02);
   map.Add(behind);
   fovea::Patch far = FrontoPatch(pair.left, z0 + 5.0);
   map.Add(far);

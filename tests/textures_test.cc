@@ -1,7 +1,8 @@
+#include "scenes/textures.h"
+
 #include <catch2/catch.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "scenes/textures.h"
 #include "sim/config.h"
 
 namespace {
@@ -44,7 +45,8 @@ TEST_CASE("textures are identical for the same seed and differ between seeds", "
   CHECK_THROWS_AS(scenes::MakeTexture("marble", 1), sim::SceneError);
 }
 
-TEST_CASE("textured kinds have detail at the texel scale, and uniform has no gradient", "[scenes]") {
+TEST_CASE("textured kinds have detail at the texel scale, and uniform has no gradient",
+          "[scenes]") {
   for (const std::string& kind : scenes::TextureKinds()) {
     INFO(kind);
     const cv::Mat g = Gray(scenes::MakeTexture(kind, 3));

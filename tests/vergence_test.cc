@@ -1,16 +1,19 @@
+#include "fovea/vergence.h"
+
 #include <catch2/catch.hpp>
 #include <cmath>
 
 #include "fovea/geometry.h"
-#include "fovea/vergence.h"
 #include "test_rig.h"
 
-TEST_CASE("vergence puts the point on both optical axes despite the centre offset", "[fovea][vergence]") {
+TEST_CASE("vergence puts the point on both optical axes despite the centre offset",
+          "[fovea][vergence]") {
   const auto g = TestGeometry();
   const auto k = rig::CameraIntrinsics::FromHorizontalFov(640, 480, 30 * M_PI / 180);
   const rig::StageState base = rig::StageState::Parallel(0.12);
-  for (const Eigen::Vector3d& p : {Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0.2, 0.6, -0.1),
-                                   Eigen::Vector3d(-0.3, 1.4, 0.2), Eigen::Vector3d(0.05, 0.45, 0.05)}) {
+  for (const Eigen::Vector3d& p :
+       {Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0.2, 0.6, -0.1), Eigen::Vector3d(-0.3, 1.4, 0.2),
+        Eigen::Vector3d(0.05, 0.45, 0.05)}) {
     INFO(p.transpose());
     const auto sol = fovea::Verge(g, TestLimits(), k, k, base, p);
     REQUIRE(sol.ok);
@@ -35,10 +38,12 @@ TEST_CASE("points that cannot be fixated are reported, not clamped", "[fovea][ve
   const auto g = TestGeometry();
   const auto k = rig::CameraIntrinsics::FromHorizontalFov(640, 480, 30 * M_PI / 180);
   const rig::StageState base = rig::StageState::Parallel(0.12);
-  const auto beside = fovea::Verge(g, TestLimits(), k, k, base, Eigen::Vector3d(2.0, 0.5, 0));  // 76 deg pan
+  const auto beside =
+      fovea::Verge(g, TestLimits(), k, k, base, Eigen::Vector3d(2.0, 0.5, 0));  // 76 deg pan
   CHECK_FALSE(beside.ok);
   CHECK(beside.why.find("limits") != std::string::npos);
-  const auto above = fovea::Verge(g, TestLimits(), k, k, base, Eigen::Vector3d(0, 0.5, 0.5));  // 45 deg tilt
+  const auto above =
+      fovea::Verge(g, TestLimits(), k, k, base, Eigen::Vector3d(0, 0.5, 0.5));  // 45 deg tilt
   CHECK_FALSE(above.ok);
   const auto near = fovea::Verge(g, TestLimits(), k, k, base, Eigen::Vector3d(0, 0.1, 0));
   CHECK_FALSE(near.ok);

@@ -1,8 +1,8 @@
+#include "fovea/zero_crossings.h"
+
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
-
-#include "fovea/zero_crossings.h"
 
 namespace {
 fovea::ZeroCrossingOptions Options() { return {}; }
@@ -57,7 +57,8 @@ TEST_CASE("a sinusoid's crossings alternate in polarity, a period apart", "[fove
   CHECK(checked > 200);
 }
 
-TEST_CASE("the unambiguous disparity limit keeps the asked share of periods above it", "[fovea][zc]") {
+TEST_CASE("the unambiguous disparity limit keeps the asked share of periods above it",
+          "[fovea][zc]") {
   std::vector<float> periods(95, 20.0f);
   periods.insert(periods.end(), 5, 6.0f);
   // 90%: the 10th smallest period is 20, so d_max just under it.
@@ -68,7 +69,8 @@ TEST_CASE("the unambiguous disparity limit keeps the asked share of periods abov
   // Whatever the share, at least that share of periods exceeds d_max.
   for (double share : {0.5, 0.9, 0.95, 0.99}) {
     const double d = fovea::UnambiguousDisparityLimit(periods, share);
-    const auto above = std::count_if(periods.begin(), periods.end(), [&](float p) { return p > d; });
+    const auto above =
+        std::count_if(periods.begin(), periods.end(), [&](float p) { return p > d; });
     CHECK(above >= share * periods.size());
   }
 }

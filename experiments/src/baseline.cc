@@ -13,13 +13,16 @@ double StaticBaseline(const rig::Rig& rig, double min_depth_m) {
   const rig::CameraIntrinsics k = rig.Intrinsics(rig::Side::kLeft);
   const double useful = 0.5 * k.width_px * min_depth_m / k.fx_px;
   const rig::RigLimits& limits = rig.Limits();
-  const double widest = limits[rig::Axis::kRightBaseline].max - limits[rig::Axis::kLeftBaseline].min;
+  const double widest =
+      limits[rig::Axis::kRightBaseline].max - limits[rig::Axis::kLeftBaseline].min;
   return std::min(useful, widest);
 }
 
-fovea::PatchMap DepthToPatches(const rig::CameraView& view, const cv::Mat& depth_m, double fb_px, int block_px) {
+fovea::PatchMap DepthToPatches(const rig::CameraView& view, const cv::Mat& depth_m, double fb_px,
+                               int block_px) {
   fovea::PatchMap map;
-  fovea::PlaneFitOptions fit_options{/*min_support=*/(3 * block_px * block_px) / 4, /*fit_tolerance_px=*/1.0,
+  fovea::PlaneFitOptions fit_options{/*min_support=*/(3 * block_px * block_px) / 4,
+                                     /*fit_tolerance_px=*/1.0,
                                      /*min_inlier_share=*/0.8, /*require_quadrants=*/true};
   const rig::CameraIntrinsics& k = view.intrinsics;
   for (int by = 0; by + block_px <= depth_m.rows; by += block_px)
@@ -34,7 +37,8 @@ fovea::PatchMap DepthToPatches(const rig::CameraView& view, const cv::Mat& depth
       const auto fit = fovea::FitDisparityPlane(samples, bx, by, block_px, fit_options, &box);
       if (!fit) continue;
       const double x0 = std::max(bx - 0.5, box(0) - 0.5), y0 = std::max(by - 0.5, box(1) - 0.5);
-      const double x1 = std::min(bx + block_px - 0.5, box(2) + 0.5), y1 = std::min(by + block_px - 0.5, box(3) + 0.5);
+      const double x1 = std::min(bx + block_px - 0.5, box(2) + 0.5),
+                   y1 = std::min(by + block_px - 0.5, box(3) + 0.5);
       fovea::Patch p;
       p.level = fovea::PatchLevel::kFoveal;
       p.resolution_level = 0;
@@ -54,7 +58,8 @@ fovea::PatchMap DepthToPatches(const rig::CameraView& view, const cv::Mat& depth
 
 StaticSgbmResult RunStaticSgbm(rig::Rig& rig, const StaticSgbmOptions& options) {
   StaticSgbmResult r;
-  r.baseline_m = options.baseline_m > 0 ? options.baseline_m : StaticBaseline(rig, options.min_depth_m);
+  r.baseline_m =
+      options.baseline_m > 0 ? options.baseline_m : StaticBaseline(rig, options.min_depth_m);
   rig::StageState state = rig.Home();
   const double centre = 0.5 * (state.left.baseline_m + state.right.baseline_m);
   state.left.baseline_m = centre - 0.5 * r.baseline_m;
@@ -65,9 +70,11 @@ StaticSgbmResult RunStaticSgbm(rig::Rig& rig, const StaticSgbmOptions& options) 
   r.motion_time_s = move.motion_time_s;
   const rig::StereoFrame frame = rig.Capture();
   const auto t0 = std::chrono::steady_clock::now();
-  const cv::Mat depth = fovea::RectifiedSgbmDepth(frame.left, frame.right, options.min_depth_m, 100.0);
+  const cv::Mat depth =
+      fovea::RectifiedSgbmDepth(frame.left, frame.right, options.min_depth_m, 100.0);
   r.depth_pixels = cv::countNonZero(depth);
-  const double b = (frame.right.world_T_camera.translation() - frame.left.world_T_camera.translation()).norm();
+  const double b =
+      (frame.right.world_T_camera.translation() - frame.left.world_T_camera.translation()).norm();
   r.map = DepthToPatches(frame.left, depth, frame.left.intrinsics.fx_px * b, options.block_px);
   r.compute_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;

@@ -30,7 +30,8 @@ double StaticBaseline(const rig::Rig& rig, double min_depth_m);
 /// Block plane fits of a planar-depth image (CV_32F, 0 = none) of `view`:
 /// fitted in fb / Z, which is affine in the image for a plane, with a 1 px
 /// tolerance; every patch is full-resolution (level foveal, resolution 0).
-fovea::PatchMap DepthToPatches(const rig::CameraView& view, const cv::Mat& depth_m, double fb_px, int block_px);
+fovea::PatchMap DepthToPatches(const rig::CameraView& view, const cv::Mat& depth_m, double fb_px,
+                               int block_px);
 
 /// Moves to the home pose's heads at the static baseline, captures, runs
 /// StereoSGBM on the rectified pair and fits patches.

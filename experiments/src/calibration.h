@@ -11,12 +11,13 @@
 namespace experiments {
 
 struct CalibrationResult {
-  rig::RigCalibration calibration;  ///< intrinsics and distortion; head offsets zero (not identifiable)
+  rig::RigCalibration
+      calibration;  ///< intrinsics and distortion; head offsets zero (not identifiable)
   cv::Mat r_right_left, t_right_left;  ///< right camera from left camera
-  double baseline_m = 0;            ///< |T|
+  double baseline_m = 0;               ///< |T|
   double rms_left_px = 0, rms_right_px = 0, rms_stereo_px = 0;
-  int views = 0;                    ///< pairs with the board found in both images
-  std::vector<std::string> skipped; ///< files where it was not found
+  int views = 0;                     ///< pairs with the board found in both images
+  std::vector<std::string> skipped;  ///< files where it was not found
 };
 
 /// Finds a board of `cols` x `rows` inner corners, `square_m` apart, in each
@@ -25,7 +26,8 @@ struct CalibrationResult {
 /// Throws UsageError on unreadable files, mismatched sizes or fewer than 3
 /// usable pairs.
 CalibrationResult CalibrateStereo(const std::vector<std::string>& left_files,
-                                  const std::vector<std::string>& right_files, int cols, int rows, double square_m);
+                                  const std::vector<std::string>& right_files, int cols, int rows,
+                                  double square_m);
 
 /// Writes `views` pairs left_NN.png / right_NN.png of a chessboard (9 x 6
 /// inner corners, `square_m` squares) rendered by the simulator at known,
@@ -34,7 +36,8 @@ CalibrationResult CalibrateStereo(const std::vector<std::string>& left_files,
 struct SyntheticTruth {
   double fx_px = 0, fy_px = 0, cx_px = 0, cy_px = 0, baseline_m = 0;
 };
-SyntheticTruth RenderChessboardViews(const std::string& dir, int views, double square_m, uint64_t seed);
+SyntheticTruth RenderChessboardViews(const std::string& dir, int views, double square_m,
+                                     uint64_t seed);
 
 /// Files matching a shell pattern, sorted; throws UsageError if none.
 std::vector<std::string> Glob(const std::string& pattern);

@@ -80,7 +80,8 @@ void AddBenchCommand(CLI::App& app, std::function<int()>* run) {
   auto args = std::make_shared<BenchRenderArgs>();
   CLI::App* render = bench->add_subcommand("render", "offscreen rendering speed");
   args->scene.Register(render, /*with_state=*/false);
-  render->add_option("--frames", args->frames, "frames per measurement")->check(CLI::Range(1, 10000));
+  render->add_option("--frames", args->frames, "frames per measurement")
+      ->check(CLI::Range(1, 10000));
   render->add_flag("--json", args->json, "one JSON object on stdout");
   render->callback([args, run] { *run = [args] { return BenchRender(*args); }; });
   AddBenchFixationCommand(*bench, run);
@@ -92,9 +93,9 @@ void AddBenchCommand(CLI::App& app, std::function<int()>* run) {
 // and against StereoSGBM on the rectified full frame, one run, one machine.
 #include <opencv2/imgproc.hpp>
 
-#include "foveal_eval.h"
 #include "fovea/idr.h"
 #include "fovea/sgbm.h"
+#include "foveal_eval.h"
 
 namespace experiments {
 namespace {
@@ -107,10 +108,13 @@ struct BenchFixationArgs {
 
 int BenchFixation(const BenchFixationArgs& args) {
   using Clock = std::chrono::steady_clock;
-  auto ms = [](Clock::time_point t0) { return 1e3 * std::chrono::duration<double>(Clock::now() - t0).count(); };
+  auto ms = [](Clock::time_point t0) {
+    return 1e3 * std::chrono::duration<double>(Clock::now() - t0).count();
+  };
   RunConfig config;  // the run's defaults: noise on
   args.scene.ApplyTo(&config);
-  const Eigen::Vector3d p(*ParseNumber(args.point[0]), *ParseNumber(args.point[1]), *ParseNumber(args.point[2]));
+  const Eigen::Vector3d p(*ParseNumber(args.point[0]), *ParseNumber(args.point[1]),
+                          *ParseNumber(args.point[2]));
   auto sim = LoadSceneOf(config);
   rig::Rig& rig = sim->rig();
   const fovea::IdrResult idr = fovea::RunIdr(rig, {});
@@ -132,13 +136,15 @@ int BenchFixation(const BenchFixationArgs& args) {
   };
   // The same depth range the fovea searches: Z_T about the fixation depth.
   const double z_near = t.fixation_depth_m - t.z_t_near_m, z_far = t.fixation_depth_m + t.z_t_far_m;
-  const double d_lo = disparity_at(k.cx_px, k.cy_px, z_far), d_hi = disparity_at(k.cx_px, k.cy_px, z_near);
+  const double d_lo = disparity_at(k.cx_px, k.cy_px, z_far),
+               d_hi = disparity_at(k.cx_px, k.cy_px, z_near);
 
   // Full-resolution NL1 over the whole frame.
   auto t0 = Clock::now();
-  const fovea::DisparityMap full = nl1.Match(left.gray, frame.right.gray,
-                                             cv::Mat(left.gray.size(), CV_32F, cv::Scalar(std::min(d_lo, d_hi) - 1)),
-                                             cv::Mat(left.gray.size(), CV_32F, cv::Scalar(std::max(d_lo, d_hi) + 1)));
+  const fovea::DisparityMap full =
+      nl1.Match(left.gray, frame.right.gray,
+                cv::Mat(left.gray.size(), CV_32F, cv::Scalar(std::min(d_lo, d_hi) - 1)),
+                cv::Mat(left.gray.size(), CV_32F, cv::Scalar(std::max(d_lo, d_hi) + 1)));
   const double full_ms = ms(t0);
   // StereoSGBM on the rectified full frame.
   t0 = Clock::now();
@@ -166,32 +172,33 @@ int BenchFixation(const BenchFixationArgs& args) {
     std::nth_element(e.begin(), e.begin() + e.size() / 2, e.end());
     return e[e.size() / 2];
   };
-  nlohmann::json j = {{"scene", sim->scene_path()},
-                      {"fovea_px", {fovea.width, fovea.height}},
-                      {"levels", t.rects.size()},
-                      {"foveated_ms", foveated_ms},
-                      {"full_res_ms", full_ms},
-                      {"sgbm_ms", sgbm_ms},
-                      {"foveal_error_px", score.levels[0].median_disparity_error_px},
-                      {"full_res_error_px", median(full_err)},
-                      {"sgbm_error_px", median(sgbm_err)},
-                      {"full_res_fovea_coverage", fovea_pixels ? double(full_err.size()) / fovea_pixels : 0.0},
-                      {"sgbm_fovea_coverage", fovea_pixels ? double(sgbm_err.size()) / fovea_pixels : 0.0},
-                      {"foveal_coverage", score.fovea_coverage},
-                      {"disparity_range_px", {std::min(d_lo, d_hi), std::max(d_lo, d_hi)}},
-                      {"full_res_over_foveated", full_ms / foveated_ms},
-                      {"sgbm_over_foveated", sgbm_ms / foveated_ms}};
+  nlohmann::json j = {
+      {"scene", sim->scene_path()},
+      {"fovea_px", {fovea.width, fovea.height}},
+      {"levels", t.rects.size()},
+      {"foveated_ms", foveated_ms},
+      {"full_res_ms", full_ms},
+      {"sgbm_ms", sgbm_ms},
+      {"foveal_error_px", score.levels[0].median_disparity_error_px},
+      {"full_res_error_px", median(full_err)},
+      {"sgbm_error_px", median(sgbm_err)},
+      {"full_res_fovea_coverage", fovea_pixels ? double(full_err.size()) / fovea_pixels : 0.0},
+      {"sgbm_fovea_coverage", fovea_pixels ? double(sgbm_err.size()) / fovea_pixels : 0.0},
+      {"foveal_coverage", score.fovea_coverage},
+      {"disparity_range_px", {std::min(d_lo, d_hi), std::max(d_lo, d_hi)}},
+      {"full_res_over_foveated", full_ms / foveated_ms},
+      {"sgbm_over_foveated", sgbm_ms / foveated_ms}};
   if (args.json) {
     std::printf("%s\n", j.dump().c_str());
   } else {
-    std::printf("fixation benchmark, %s, fovea %dx%d, %zu levels\n", sim->scene_path().c_str(), fovea.width,
-                fovea.height, t.rects.size());
+    std::printf("fixation benchmark, %s, fovea %dx%d, %zu levels\n", sim->scene_path().c_str(),
+                fovea.width, fovea.height, t.rects.size());
     std::printf("  foveated NL1 (all levels)   %8.1f ms   foveal error %.3f px\n", foveated_ms,
                 j["foveal_error_px"].get<double>());
-    std::printf("  full-resolution NL1         %8.1f ms   foveal error %.3f px  (%.1fx the time)\n", full_ms,
-                j["full_res_error_px"].get<double>(), full_ms / foveated_ms);
-    std::printf("  StereoSGBM, rectified frame %8.1f ms   foveal error %.3f px  (%.1fx the time)\n", sgbm_ms,
-                j["sgbm_error_px"].get<double>(), sgbm_ms / foveated_ms);
+    std::printf("  full-resolution NL1         %8.1f ms   foveal error %.3f px  (%.1fx the time)\n",
+                full_ms, j["full_res_error_px"].get<double>(), full_ms / foveated_ms);
+    std::printf("  StereoSGBM, rectified frame %8.1f ms   foveal error %.3f px  (%.1fx the time)\n",
+                sgbm_ms, j["sgbm_error_px"].get<double>(), sgbm_ms / foveated_ms);
   }
   return 0;
 }
@@ -201,7 +208,8 @@ int BenchFixation(const BenchFixationArgs& args) {
 void AddBenchFixationCommand(CLI::App& bench, std::function<int()>* run) {
   auto args = std::make_shared<BenchFixationArgs>();
   args->scene.scene = "cylinder_planes";
-  CLI::App* cmd = bench.add_subcommand("fixation", "foveated matching vs full-resolution NL1 vs StereoSGBM");
+  CLI::App* cmd =
+      bench.add_subcommand("fixation", "foveated matching vs full-resolution NL1 vs StereoSGBM");
   args->scene.Register(cmd, /*with_state=*/false);
   cmd->add_option("--point", args->point, "fixation point X Y Z, metres")
       ->expected(3)

@@ -26,8 +26,8 @@ void Label(cv::Mat& image, const std::string& text) {
 
 int Catalog(const CatalogArgs& args) {
   // One file into a folder that may hold others (the README's figures).
-  const std::string sheet_path =
-      CheckOutputFile(NormalizeOutputPath(args.out, "--out") + "/contact_sheet.png", "--out", args.force);
+  const std::string sheet_path = CheckOutputFile(
+      NormalizeOutputPath(args.out, "--out") + "/contact_sheet.png", "--out", args.force);
   std::vector<cv::Mat> rows;
   for (const std::string& name : scenes::CatalogNames()) {
     RunConfig config;
@@ -35,7 +35,8 @@ int Catalog(const CatalogArgs& args) {
     config.scene = name;
     auto sim = LoadSceneOf(config);
     const rig::StereoFrame frame = sim->rig().Capture({/*color=*/true});
-    const sim::TrueView truth = sim->truth().Render(frame.left.world_T_camera, frame.left.intrinsics);
+    const sim::TrueView truth =
+        sim->truth().Render(frame.left.world_T_camera, frame.left.intrinsics);
     cv::Mat left, right, depth;
     const double scale = double(args.thumb_width) / frame.left.bgr.cols;
     cv::resize(frame.left.bgr, left, {}, scale, scale, cv::INTER_AREA);
@@ -76,7 +77,8 @@ int Textures(const TexturesArgs& args) {
     WriteImageAtomic(folder.path() + "/" + names.back(), scenes::MakeTexture(kind, seed));
   }
   folder.Commit();
-  for (const std::string& name : names) std::printf("%s/%s\n", folder.target().c_str(), name.c_str());
+  for (const std::string& name : names)
+    std::printf("%s/%s\n", folder.target().c_str(), name.c_str());
   return 0;
 }
 
@@ -86,17 +88,21 @@ void AddCatalogCommands(CLI::App& app, std::function<int()>* run) {
   auto cat = std::make_shared<CatalogArgs>();
   CLI::App* c = app.add_subcommand(
       "catalog", "render every catalog scene at the home pose into one contact sheet PNG");
-  c->add_option("--out", cat->out, "folder to write contact_sheet.png into (it may hold other files)")->required();
-  c->add_option("--width", cat->thumb_width, "thumbnail width in pixels")->check(CLI::Range(64, 1280));
+  c->add_option("--out", cat->out,
+                "folder to write contact_sheet.png into (it may hold other files)")
+      ->required();
+  c->add_option("--width", cat->thumb_width, "thumbnail width in pixels")
+      ->check(CLI::Range(64, 1280));
   c->add_flag("--force", cat->force, "replace an existing contact_sheet.png there");
   c->callback([cat, run] { *run = [cat] { return Catalog(*cat); }; });
 
   auto tex = std::make_shared<TexturesArgs>();
-  CLI::App* t = app.add_subcommand(
-      "textures", "write every procedural texture kind as <kind>-s<seed>.png");
+  CLI::App* t =
+      app.add_subcommand("textures", "write every procedural texture kind as <kind>-s<seed>.png");
   t->add_option("--out", tex->out, "output folder (new, or empty)")->required();
   AddForceFlag(t, &tex->force);
-  t->add_option("--seed", tex->seed, "texture seed")->check(NumberIn(0, 9007199254740992.0, /*whole=*/true));
+  t->add_option("--seed", tex->seed, "texture seed")
+      ->check(NumberIn(0, 9007199254740992.0, /*whole=*/true));
   t->callback([tex, run] { *run = [tex] { return Textures(*tex); }; });
 }
 

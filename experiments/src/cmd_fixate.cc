@@ -2,9 +2,9 @@
 #include <opencv2/imgproc.hpp>
 
 #include "commands.h"
-#include "foveal_eval.h"
 #include "fovea/idr.h"
 #include "fovea/sgbm.h"
+#include "foveal_eval.h"
 #include "output.h"
 #include "run_output.h"
 #include "scene_options.h"
@@ -22,17 +22,21 @@ struct FixateArgs {
 int Fixate(const FixateArgs& args) {
   RunConfig config;  // the run's defaults: noise on
   args.scene.ApplyTo(&config);
-  if (!args.baseline.empty()) SetParamFromFlag(&config, "--baseline", "foveal.baseline_m", args.baseline);
+  if (!args.baseline.empty())
+    SetParamFromFlag(&config, "--baseline", "foveal.baseline_m", args.baseline);
   if (!args.matcher.empty()) SetParamFromFlag(&config, "--matcher", "matcher", args.matcher);
   config.Check();
-  const Eigen::Vector3d p(*ParseNumber(args.point[0]), *ParseNumber(args.point[1]), *ParseNumber(args.point[2]));
+  const Eigen::Vector3d p(*ParseNumber(args.point[0]), *ParseNumber(args.point[1]),
+                          *ParseNumber(args.point[2]));
   OutputFolder folder(args.out, "--out", ExistingPolicy(args.force));
   auto sim = LoadSceneOf(config);
   rig::Rig& rig = sim->rig();
   const fovea::IdrResult idr = fovea::RunIdr(rig, {});
   std::unique_ptr<fovea::StereoMatcher> matcher;
-  if (config.matcher == "sgbm") matcher = std::make_unique<fovea::SgbmMatcher>();
-  else matcher = std::make_unique<fovea::Nl1Matcher>();
+  if (config.matcher == "sgbm")
+    matcher = std::make_unique<fovea::SgbmMatcher>();
+  else
+    matcher = std::make_unique<fovea::Nl1Matcher>();
   const fovea::FixationResult r = fovea::Fixate(rig, idr.map, p, *matcher, config.fovea.fixation);
   if (!r.ok) {
     char at[96];
@@ -48,9 +52,11 @@ int Fixate(const FixateArgs& args) {
   cv::Mat overlay;
   cv::cvtColor(left.gray, overlay, cv::COLOR_GRAY2BGR);
   overlay.setTo(cv::Scalar(60, 60, 200), t.mask == 0);
-  const cv::Scalar colours[] = {{0, 255, 0}, {0, 200, 255}, {255, 160, 0}, {255, 0, 255}, {255, 255, 255}, {128, 128, 128}};
+  const cv::Scalar colours[] = {{0, 255, 0},   {0, 200, 255},   {255, 160, 0},
+                                {255, 0, 255}, {255, 255, 255}, {128, 128, 128}};
   for (size_t k = 0; k < t.rects.size(); ++k) cv::rectangle(overlay, t.rects[k], colours[k % 6], 2);
-  cv::drawMarker(overlay, {int(left.intrinsics.cx_px), int(left.intrinsics.cy_px)}, {0, 0, 255}, cv::MARKER_CROSS, 20, 2);
+  cv::drawMarker(overlay, {int(left.intrinsics.cx_px), int(left.intrinsics.cy_px)}, {0, 0, 255},
+                 cv::MARKER_CROSS, 20, 2);
   WriteImageAtomic(dir + "/tessellation.png", overlay);
   // Per-level disparity, colour-mapped, upsampled to full size.
   for (size_t k = 0; k < r.foveal.disparity_px.size(); ++k) {
@@ -59,14 +65,16 @@ int Fixate(const FixateArgs& args) {
     double lo = 0, hi = 0;
     if (cv::countNonZero(valid)) cv::minMaxLoc(d, &lo, &hi, nullptr, nullptr, valid);
     cv::Mat scaled, colour;
-    d.convertTo(scaled, CV_8U, 255.0 / std::max(1e-6, hi - lo), -255.0 * lo / std::max(1e-6, hi - lo));
+    d.convertTo(scaled, CV_8U, 255.0 / std::max(1e-6, hi - lo),
+                -255.0 * lo / std::max(1e-6, hi - lo));
     cv::applyColorMap(scaled, colour, cv::COLORMAP_TURBO);
     colour.setTo(cv::Scalar(0, 0, 0), ~valid);
     cv::resize(colour, colour, left.gray.size(), 0, 0, cv::INTER_NEAREST);
     WriteImageAtomic(dir + "/disparity_level" + std::to_string(k) + ".png", colour);
   }
   // This fixation's patches beside the true depth, from the left camera.
-  WriteImageAtomic(dir + "/patch_depth_vs_true.png", PatchDepthBesideTruth(r.foveal.patches, left, sim->truth()));
+  WriteImageAtomic(dir + "/patch_depth_vs_true.png",
+                   PatchDepthBesideTruth(r.foveal.patches, left, sim->truth()));
 
   nlohmann::json j = FixationJson(r, score);
   j["scene"] = sim->scene_path();
@@ -74,10 +82,12 @@ int Fixate(const FixateArgs& args) {
   j["matcher"] = matcher->Name();
   WriteTextAtomic(dir + "/fixate.json", j.dump(2) + "\n");
   folder.Commit();
-  std::fprintf(stderr, "fovea fixate: fovea %dx%d, %zu levels, %zu patches, foveal error %.3f steps, coverage %.3f -> %s\n",
+  std::fprintf(stderr,
+               "fovea fixate: fovea %dx%d, %zu levels, %zu patches, foveal error %.3f steps, "
+               "coverage %.3f -> %s\n",
                t.rects[0].width, t.rects[0].height, t.rects.size(), r.foveal.patches.size(),
-               score.levels.empty() ? 0.0 : score.levels[0].median_error_steps, score.fovea_coverage,
-               folder.target().c_str());
+               score.levels.empty() ? 0.0 : score.levels[0].median_error_steps,
+               score.fovea_coverage, folder.target().c_str());
   return 0;
 }
 
@@ -85,7 +95,8 @@ int Fixate(const FixateArgs& args) {
 
 void AddFixateCommand(CLI::App& app, std::function<int()>* run) {
   auto args = std::make_shared<FixateArgs>();
-  CLI::App* cmd = app.add_subcommand("fixate", "IDR, then verge on a point and recover its foveated depth map");
+  CLI::App* cmd =
+      app.add_subcommand("fixate", "IDR, then verge on a point and recover its foveated depth map");
   args->scene.Register(cmd, /*with_state=*/false);
   cmd->add_option("--point", args->point, "fixation point X Y Z in the world, metres")
       ->required()
@@ -94,7 +105,8 @@ void AddFixateCommand(CLI::App& app, std::function<int()>* run) {
   cmd->add_option("--out", args->out, "output folder (new, or empty)")->required();
   AddForceFlag(cmd, &args->force);
   cmd->add_option("--baseline", args->baseline, "vergent baseline, metres (foveal.baseline_m)");
-  cmd->add_option("--matcher", args->matcher, "per-level matcher: nl1 (the paper's cost) or sgbm (matcher)");
+  cmd->add_option("--matcher", args->matcher,
+                  "per-level matcher: nl1 (the paper's cost) or sgbm (matcher)");
   cmd->callback([args, run] { *run = [args] { return Fixate(*args); }; });
 }
 

@@ -20,9 +20,11 @@ void OnQuit(int) { g_quit = 1; }
 void AddHardwareCommands(CLI::App& app, std::function<int()>* run) {
   auto units = std::make_shared<std::vector<int>>(std::vector<int>{1, 2, 3, 4, 5, 6});
   auto seconds = std::make_shared<double>(0);
-  CLI::App* cmd = app.add_subcommand("indexer-emulator",
-                                     "emulate the chain of indexers on a pseudo-terminal (prints its path)");
-  cmd->add_option("--units", *units, "unit addresses on the chain")->delimiter(',')->check(CLI::Range(1, 99));
+  CLI::App* cmd = app.add_subcommand(
+      "indexer-emulator", "emulate the chain of indexers on a pseudo-terminal (prints its path)");
+  cmd->add_option("--units", *units, "unit addresses on the chain")
+      ->delimiter(',')
+      ->check(CLI::Range(1, 99));
   cmd->add_option("--seconds", *seconds, "stop after this long (0 = until SIGINT/SIGTERM)")
       ->check(NumberIn(0, 1e7));
   cmd->callback([units, seconds, run] {
@@ -34,8 +36,8 @@ void AddHardwareCommands(CLI::App& app, std::function<int()>* run) {
       rig::IndexerEmulator emulator(*units);
       std::printf("%s\n", emulator.Path().c_str());
       std::fflush(stdout);
-      std::fprintf(stderr, "fovea indexer-emulator: %zu units on %s (Ctrl-C to stop)\n", units->size(),
-                   emulator.Path().c_str());
+      std::fprintf(stderr, "fovea indexer-emulator: %zu units on %s (Ctrl-C to stop)\n",
+                   units->size(), emulator.Path().c_str());
       signal(SIGINT, OnQuit);
       signal(SIGTERM, OnQuit);
       const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(*seconds);

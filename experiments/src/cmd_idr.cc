@@ -20,11 +20,14 @@ int Idr(const IdrArgs& args) {
   RunConfig config;  // the run's defaults: noise on
   args.scene.ApplyTo(&config);
   if (!args.sigma.empty()) SetParamFromFlag(&config, "--sigma", "idr.log_sigma_px", args.sigma);
-  if (!args.unique_share.empty()) SetParamFromFlag(&config, "--unique-share", "idr.unique_share", args.unique_share);
-  if (!args.patch_size.empty()) SetParamFromFlag(&config, "--patch-size", "idr.patch_size_px", args.patch_size);
+  if (!args.unique_share.empty())
+    SetParamFromFlag(&config, "--unique-share", "idr.unique_share", args.unique_share);
+  if (!args.patch_size.empty())
+    SetParamFromFlag(&config, "--patch-size", "idr.patch_size_px", args.patch_size);
   config.Check();
   fovea::IdrOptions idr = config.fovea.idr;
-  if (!args.initial_baseline.empty()) idr.fixed_initial_baseline_m = *ParseNumber(args.initial_baseline);
+  if (!args.initial_baseline.empty())
+    idr.fixed_initial_baseline_m = *ParseNumber(args.initial_baseline);
   idr.matching.take_nearest_when_ambiguous = args.take_nearest;
   OutputFolder folder(args.out, "--out", ExistingPolicy(args.force));
   auto sim = LoadSceneOf(config);
@@ -33,21 +36,25 @@ int Idr(const IdrArgs& args) {
   const std::string dir = folder.path();
 
   const rig::CameraView& left = r.final_frame.left;
-  const double b = (r.final_frame.right.world_T_camera.translation() - left.world_T_camera.translation()).norm();
+  const double b =
+      (r.final_frame.right.world_T_camera.translation() - left.world_T_camera.translation()).norm();
   // Matched crossings' disparities over the dimmed left image.
   cv::Mat disparity;
   cv::cvtColor(left.gray / 2, disparity, cv::COLOR_GRAY2BGR);
   double d_lo = 1e9, d_hi = -1e9;
-  for (const auto& m : r.final_samples) d_lo = std::min(d_lo, m.disparity_px), d_hi = std::max(d_hi, m.disparity_px);
+  for (const auto& m : r.final_samples)
+    d_lo = std::min(d_lo, m.disparity_px), d_hi = std::max(d_hi, m.disparity_px);
   for (const auto& m : r.final_samples) {
     cv::Mat v(1, 1, CV_8U, cv::Scalar(255 * (m.disparity_px - d_lo) / std::max(1e-6, d_hi - d_lo)));
     cv::Mat c;
     cv::applyColorMap(v, c, cv::COLORMAP_TURBO);
-    cv::circle(disparity, {int(m.x_px + 0.5), int(m.y_px)}, 1, cv::Scalar(c.at<cv::Vec3b>(0, 0)), cv::FILLED);
+    cv::circle(disparity, {int(m.x_px + 0.5), int(m.y_px)}, 1, cv::Scalar(c.at<cv::Vec3b>(0, 0)),
+               cv::FILLED);
   }
   WriteImageAtomic(dir + "/disparity.png", disparity);
   // Patch depth beside true depth, one colour scale.
-  WriteImageAtomic(dir + "/patch_depth_vs_true.png", PatchDepthBesideTruth(r.map, left, sim->truth()));
+  WriteImageAtomic(dir + "/patch_depth_vs_true.png",
+                   PatchDepthBesideTruth(r.map, left, sim->truth()));
 
   nlohmann::json j = IdrJson(r, score);
   j["scene"] = sim->scene_path();
@@ -66,12 +73,14 @@ int Idr(const IdrArgs& args) {
 
 void AddIdrCommand(CLI::App& app, std::function<int()>* run) {
   auto args = std::make_shared<IdrArgs>();
-  CLI::App* cmd = app.add_subcommand("idr", "initial depth recovery: adaptive variable-baseline stereo");
+  CLI::App* cmd =
+      app.add_subcommand("idr", "initial depth recovery: adaptive variable-baseline stereo");
   args->scene.Register(cmd, /*with_state=*/false);
   cmd->add_option("--out", args->out, "output folder (new, or empty)")->required();
   AddForceFlag(cmd, &args->force);
   cmd->add_option("--sigma", args->sigma, "LoG sigma, px (idr.log_sigma_px)");
-  cmd->add_option("--unique-share", args->unique_share, "share of unambiguous crossings at B0 (idr.unique_share)");
+  cmd->add_option("--unique-share", args->unique_share,
+                  "share of unambiguous crossings at B0 (idr.unique_share)");
   cmd->add_option("--patch-size", args->patch_size, "patch size, px (idr.patch_size_px)");
   cmd->add_option("--initial-baseline", args->initial_baseline,
                   "fixed initial baseline in metres instead of the period rule (0 = rule)")

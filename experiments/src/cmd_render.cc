@@ -13,7 +13,8 @@ nlohmann::json PoseJson(const Eigen::Isometry3d& pose) {
   nlohmann::json j;
   j["translation_m"] = {pose.translation().x(), pose.translation().y(), pose.translation().z()};
   nlohmann::json rows = nlohmann::json::array();
-  for (int r = 0; r < 3; ++r) rows.push_back({pose.linear()(r, 0), pose.linear()(r, 1), pose.linear()(r, 2)});
+  for (int r = 0; r < 3; ++r)
+    rows.push_back({pose.linear()(r, 0), pose.linear()(r, 1), pose.linear()(r, 2)});
   j["rotation"] = rows;
   return j;
 }
@@ -56,8 +57,12 @@ int Render(const RenderArgs& args) {
     WriteImageAtomic(dir + "/depth_" + name + "_mm.png", depth_mm);
     const rig::CameraIntrinsics& k = view.intrinsics;
     meta[name] = {{"intrinsics",
-                   {{"fx_px", k.fx_px}, {"fy_px", k.fy_px}, {"cx_px", k.cx_px}, {"cy_px", k.cy_px},
-                    {"width_px", k.width_px}, {"height_px", k.height_px}}},
+                   {{"fx_px", k.fx_px},
+                    {"fy_px", k.fy_px},
+                    {"cx_px", k.cx_px},
+                    {"cy_px", k.cy_px},
+                    {"width_px", k.width_px},
+                    {"height_px", k.height_px}}},
                   {"world_T_camera", PoseJson(view.world_T_camera)}};
   }
   WriteTextAtomic(dir + "/render.json", meta.dump(2) + "\n");

@@ -3,13 +3,14 @@
 // work starts, and written back out in full beside the results.
 #pragma once
 
+#include <yaml-cpp/node/node.h>
+
 #include <CLI/CLI.hpp>
 #include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <variant>
-#include <yaml-cpp/node/node.h>
 #include <vector>
 
 #include "fovea/ddr.h"
@@ -19,14 +20,14 @@ namespace experiments {
 
 struct RunConfig {
   RunConfig() { rig.noise.read_noise_sigma_dn = 2.0; }
-  std::string scene;                 ///< catalog name or path; empty = the default scene
-  uint64_t seed = 0;                 ///< the one seed: sensor noise and fixation draws
+  std::string scene;  ///< catalog name or path; empty = the default scene
+  uint64_t seed = 0;  ///< the one seed: sensor noise and fixation draws
   /// "fovea": the FOVEA loop; "static_sgbm": the baseline it is compared
   /// with, StereoSGBM on a static parallel pair at the home pose and the
   /// widest baseline, scored the same way.
   std::string method = "fovea";
-  std::string matcher = "nl1";       ///< per-level matcher of the foveated stage
-  sim::SimRigConfig rig;             ///< the simulated rig (its seed is `seed`)
+  std::string matcher = "nl1";  ///< per-level matcher of the foveated stage
+  sim::SimRigConfig rig;        ///< the simulated rig (its seed is `seed`)
   /// The real rig (rig.type: hardware): stages on a serial port (or the
   /// in-process emulator), two cameras, a calibration file. Axis limits and
   /// steps per unit are the rig.* ones above.
@@ -35,14 +36,14 @@ struct RunConfig {
     std::string port;
     int baud = 9600;
     bool emulate_stages = false;
-    std::string units = "1,2,3,4,5,6";    ///< indexer addresses in rig::Axis order
+    std::string units = "1,2,3,4,5,6";       ///< indexer addresses in rig::Axis order
     std::string directions = "1,1,1,1,1,1";  ///< motor direction signs in rig::Axis order
     std::string left_camera, right_camera, calibration;
     double frame_timeout_s = 2;
     double baseline_velocity_m_s = 0.05;
     double pan_tilt_velocity_rad_s = 1.0;
   } hardware;
-  double static_baseline_m = 0;      ///< static_sgbm's baseline; 0 = the widest useful
+  double static_baseline_m = 0;  ///< static_sgbm's baseline; 0 = the widest useful
   fovea::FoveaOptions fovea;
 
   /// Checks what single ranges cannot (the parts against each other);
@@ -59,7 +60,12 @@ struct ConfigParam {
   template <class T>
   ConfigParam(std::string path_, std::string doc_, T* target_, double lo_ = 0, double hi_ = 0,
               std::vector<std::string> choices_ = {})
-      : path(std::move(path_)), doc(std::move(doc_)), target(target_), lo(lo_), hi(hi_), choices(std::move(choices_)) {}
+      : path(std::move(path_)),
+        doc(std::move(doc_)),
+        target(target_),
+        lo(lo_),
+        hi(hi_),
+        choices(std::move(choices_)) {}
   std::string path;
   std::string doc;
   std::variant<double*, int*, bool*, std::string*, uint64_t*> target;
@@ -81,7 +87,8 @@ void SetParam(RunConfig* config, const std::string& path, const std::string& val
 /// The same for a command-line flag that sets parameter `path`: the flag's
 /// value is checked against the table like a YAML value, and a message names
 /// the flag ("--sigma (idr.log_sigma_px): 0 is out of range [1, 8]").
-void SetParamFromFlag(RunConfig* config, const std::string& flag, const std::string& path, const std::string& value);
+void SetParamFromFlag(RunConfig* config, const std::string& flag, const std::string& path,
+                      const std::string& value);
 
 /// The one number parser of flags and YAML values: a finite decimal number
 /// ("3", "-0.5", "2e-3") and nothing else (no NaN, infinity, hex, spaces or

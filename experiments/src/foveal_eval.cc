@@ -12,7 +12,8 @@ FovealScore ScoreFoveal(const fovea::FixationResult& r, const sim::GroundTruth& 
   const rig::StereoFrame& frame = r.servo.frame;
   const rig::CameraView& left = frame.left;
   const rig::CameraIntrinsics& k = left.intrinsics;
-  score.baseline_m = (frame.right.world_T_camera.translation() - left.world_T_camera.translation()).norm();
+  score.baseline_m =
+      (frame.right.world_T_camera.translation() - left.world_T_camera.translation()).norm();
   const double b = score.baseline_m;
   cv::Mat ids;
   const cv::Mat depth = truth.RayCastDepth(left.world_T_camera, k, &ids);
@@ -51,10 +52,13 @@ FovealScore ScoreFoveal(const fovea::FixationResult& r, const sim::GroundTruth& 
     for (int y = 0; y < d.rows; ++y)
       for (int x = 0; x < d.cols; ++x) {
         const double u = (x + 0.5) * s - 0.5, v = (y + 0.5) * s - 0.5;
-        const int ui = std::clamp(int(std::lround(u)), 0, k.width_px - 1), vi = std::clamp(int(std::lround(v)), 0, k.height_px - 1);
-        const bool in_level = t.rects[level].contains({ui, vi}) && (level == 0 || !t.rects[level - 1].contains({ui, vi}));
+        const int ui = std::clamp(int(std::lround(u)), 0, k.width_px - 1),
+                  vi = std::clamp(int(std::lround(v)), 0, k.height_px - 1);
+        const bool in_level = t.rects[level].contains({ui, vi}) &&
+                              (level == 0 || !t.rects[level - 1].contains({ui, vi}));
         const float dd = d.at<float>(y, x);
-        if (level == 0 && in_level && t.mask.at<uchar>(vi, ui) && truth.Textured(ids.at<int>(vi, ui))) {
+        if (level == 0 && in_level && t.mask.at<uchar>(vi, ui) &&
+            truth.Textured(ids.at<int>(vi, ui))) {
           ++fovea_pixels;
           if (std::isfinite(dd)) ++fovea_matched;
         }
@@ -62,7 +66,8 @@ FovealScore ScoreFoveal(const fovea::FixationResult& r, const sim::GroundTruth& 
         const float zt = depth.at<float>(vi, ui);
         if (zt <= 0) continue;
         const Eigen::Vector3d p_R = right_T_left * (zt * k.Ray({u, v}));
-        const double ur = frame.right.intrinsics.fx_px * p_R.x() / p_R.z() + frame.right.intrinsics.cx_px;
+        const double ur =
+            frame.right.intrinsics.fx_px * p_R.x() / p_R.z() + frame.right.intrinsics.cx_px;
         derr.push_back(std::abs(dd - (u - ur) / s));
       }
     score.levels[level].median_disparity_error_px = Quantile(derr, 0.5, std::nan(""));
@@ -83,21 +88,23 @@ nlohmann::json FixationJson(const fovea::FixationResult& r, const FovealScore& s
     return j;
   }
   j["fixation_W"] = {r.fixation_W.x(), r.fixation_W.y(), r.fixation_W.z()};
-  j["servo"] = {{"converged", r.servo.converged}, {"iterations", r.servo.iterations},
-                {"residual_px", r.servo.residual_px}, {"residuals_px", r.servo.residuals_px}};
+  j["servo"] = {{"converged", r.servo.converged},
+                {"iterations", r.servo.iterations},
+                {"residual_px", r.servo.residual_px},
+                {"residuals_px", r.servo.residuals_px}};
   const auto& t = r.foveal.tessellation;
-  j["tessellation"] = {{"fixation_depth_m", t.fixation_depth_m}, {"z_t_near_m", t.z_t_near_m},
-                       {"z_t_far_m", t.z_t_far_m}, {"z_max_near_m", t.z_max_near_m},
+  j["tessellation"] = {{"fixation_depth_m", t.fixation_depth_m},
+                       {"z_t_near_m", t.z_t_near_m},
+                       {"z_t_far_m", t.z_t_far_m},
+                       {"z_max_near_m", t.z_max_near_m},
                        {"z_max_far_m", t.z_max_far_m}};
   nlohmann::json levels = nlohmann::json::array();
   for (size_t i = 0; i < r.foveal.levels.size(); ++i) {
     const auto& f = r.foveal.levels[i];
-    nlohmann::json l = {{"level", f.level},
-                        {"rect", {f.rect.x, f.rect.y, f.rect.width, f.rect.height}},
-                        {"searched", f.searched},
-                        {"matched", f.matched},
-                        {"patches", f.patches},
-                        {"match_time_s", f.match_time_s}};
+    nlohmann::json l = {
+        {"level", f.level},       {"rect", {f.rect.x, f.rect.y, f.rect.width, f.rect.height}},
+        {"searched", f.searched}, {"matched", f.matched},
+        {"patches", f.patches},   {"match_time_s", f.match_time_s}};
     if (i < s.levels.size()) {
       l["median_abs_error_m"] = s.levels[i].median_abs_error_m;
       l["median_error_steps"] = s.levels[i].median_error_steps;

@@ -12,10 +12,10 @@ namespace experiments {
 struct LevelScore {
   int level = 0;
   int patches = 0;
-  double median_abs_error_m = 0;   ///< patch depth at its centre pixel vs true depth
-  double median_error_steps = 0;   ///< in this level's quantization step 2^k Z^2 / (f B)
+  double median_abs_error_m = 0;         ///< patch depth at its centre pixel vs true depth
+  double median_error_steps = 0;         ///< in this level's quantization step 2^k Z^2 / (f B)
   double median_disparity_error_px = 0;  ///< per-pixel disparities vs truth, level pixels
-  int gross_errors = 0;            ///< patches off by more than 5% of the true depth
+  int gross_errors = 0;                  ///< patches off by more than 5% of the true depth
 };
 
 struct FovealScore {

@@ -18,10 +18,11 @@ double PlaneDepth(const fovea::Patch& p, const rig::CameraView& view, const Eige
   return t;  // ray_C has z = 1, so t is the planar depth
 }
 
-double TrueDepth(const sim::GroundTruth& truth, const rig::CameraView& view, const Eigen::Vector2d& uv,
-                 int* geom = nullptr) {
+double TrueDepth(const sim::GroundTruth& truth, const rig::CameraView& view,
+                 const Eigen::Vector2d& uv, int* geom = nullptr) {
   const Eigen::Vector3d ray_C = view.intrinsics.Ray(uv);
-  const auto hit = truth.CastRay(view.world_T_camera.translation(), view.world_T_camera.linear() * ray_C);
+  const auto hit =
+      truth.CastRay(view.world_T_camera.translation(), view.world_T_camera.linear() * ray_C);
   if (geom) *geom = hit ? hit->geom_id : -1;
   return hit ? hit->distance_m / ray_C.norm() : 0;
 }
@@ -32,7 +33,8 @@ IdrScore ScoreIdr(const fovea::IdrResult& r, const sim::GroundTruth& truth) {
   IdrScore s;
   const rig::CameraView& view = r.final_frame.left;
   const rig::CameraIntrinsics& k = view.intrinsics;
-  const double b = (r.final_frame.right.world_T_camera.translation() - view.world_T_camera.translation()).norm();
+  const double b =
+      (r.final_frame.right.world_T_camera.translation() - view.world_T_camera.translation()).norm();
   if (!r.stages.empty()) s.stage0_unambiguous_share = r.stages.front().stats.UnambiguousShare();
   std::vector<double> errors, steps;
   const Eigen::Isometry3d camera_T_world = view.world_T_camera.inverse();
@@ -58,7 +60,8 @@ IdrScore ScoreIdr(const fovea::IdrResult& r, const sim::GroundTruth& truth) {
     bool straddles = false;
     for (int i = 0; i < 5; ++i)
       for (int j = 0; j < 5; ++j) {
-        const Eigen::Vector2d uv(lo.x() + (hi.x() - lo.x()) * (i + 0.5) / 5, lo.y() + (hi.y() - lo.y()) * (j + 0.5) / 5);
+        const Eigen::Vector2d uv(lo.x() + (hi.x() - lo.x()) * (i + 0.5) / 5,
+                                 lo.y() + (hi.y() - lo.y()) * (j + 0.5) / 5);
         int g = -1;
         const double zt = TrueDepth(truth, view, uv, &g);
         if (zt <= 0) continue;
@@ -120,7 +123,8 @@ nlohmann::json IdrJson(const fovea::IdrResult& r, const IdrScore& s) {
                         {"wrong_matches", s.wrong_matches},
                         {"stage0_unambiguous_share", s.stage0_unambiguous_share}}}};
   if (r.has_fixation)
-    j["first_fixation_W"] = {r.first_fixation_W.x(), r.first_fixation_W.y(), r.first_fixation_W.z()};
+    j["first_fixation_W"] = {r.first_fixation_W.x(), r.first_fixation_W.y(),
+                             r.first_fixation_W.z()};
   return j;
 }
 

@@ -3,9 +3,8 @@
 #include <cstdlib>
 #include <exception>
 #include <new>
-#include <string>
-
 #include <opencv2/core/utils/logger.hpp>
+#include <string>
 
 #include "commands.h"
 #include "output.h"
@@ -55,8 +54,10 @@ int main(int argc, char** argv) {
   // An exception escaping where it cannot be caught (a destructor, a
   // thread) still ends in one line and exit 1, not an abort.
   std::set_terminate([] {
-    if (const std::exception_ptr e = std::current_exception()) Report(e);
-    else PrintError("internal error (std::terminate)");
+    if (const std::exception_ptr e = std::current_exception())
+      Report(e);
+    else
+      PrintError("internal error (std::terminate)");
     std::_Exit(1);
   });
   // Errors reach the user as one line of ours, not as OpenCV's own log.

@@ -3,9 +3,8 @@
 #include <signal.h>
 #include <unistd.h>
 
-#include <climits>
-
 #include <cerrno>
+#include <climits>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -24,7 +23,8 @@ std::string ProcessTag() {
   char host[256] = "";
   if (gethostname(host, sizeof host - 1) != 0 || !host[0]) std::snprintf(host, sizeof host, "host");
   std::string tag;
-  for (const char* c = host; *c; ++c) tag += std::isalnum(static_cast<unsigned char>(*c)) ? *c : '_';
+  for (const char* c = host; *c; ++c)
+    tag += std::isalnum(static_cast<unsigned char>(*c)) ? *c : '_';
   return tag + "-" + std::to_string(getpid());
 }
 
@@ -55,20 +55,24 @@ std::string NormalizeOutputPath(const std::string& path, const std::string& flag
   if (!p.has_filename()) p = p.parent_path();  // "out/run/" -> "out/run"
   const std::string last = p.filename().string();
   if (p.empty() || last.empty() || last == "." || last == ".." || p == p.root_path())
-    throw UsageError(flag + ": " + Quoted(path) + " names an existing folder above the output (., .. or /); name a new folder");
+    throw UsageError(flag + ": " + Quoted(path) +
+                     " names an existing folder above the output (., .. or /); name a new folder");
   return p.string();
 }
 
-void CheckOutputTarget(const std::string& target, const std::string& flag, ExistingOutput existing) {
+void CheckOutputTarget(const std::string& target, const std::string& flag,
+                       ExistingOutput existing) {
   std::error_code ec;
   const fs::file_status s = fs::symlink_status(target, ec);
   const std::string at = flag + ": " + Quoted(target);
-  if (ec && ec != std::errc::no_such_file_or_directory) throw UsageError(at + " cannot be checked: " + ec.message());
+  if (ec && ec != std::errc::no_such_file_or_directory)
+    throw UsageError(at + " cannot be checked: " + ec.message());
   if (!fs::exists(s) || IsEmptyFolder(target)) return;
   if (fs::is_symlink(s)) throw UsageError(at + " is a symbolic link; name a new folder");
   if (!fs::is_directory(s)) throw UsageError(at + " exists and is not a folder; name a new folder");
   if (existing == ExistingOutput::kRefuse)
-    throw UsageError(at + " exists and is not empty (pass --force to replace an earlier result of fovea)");
+    throw UsageError(
+        at + " exists and is not empty (pass --force to replace an earlier result of fovea)");
   if (!fs::exists(fs::path(target) / kOutputMarker))
     throw UsageError(at + " is not empty and was not written by fovea (it has no " + kOutputMarker +
                      "); --force replaces only fovea's own output folders");
@@ -83,7 +87,8 @@ void RemoveStaleStaging(const std::string& target) {
   const fs::path p(target);
   const fs::path parent = p.parent_path().empty() ? fs::path(".") : p.parent_path();
   const std::string tag = ProcessTag();
-  const std::string prefix = "." + p.filename().string() + ".partial-" + tag.substr(0, tag.rfind('-') + 1);
+  const std::string prefix =
+      "." + p.filename().string() + ".partial-" + tag.substr(0, tag.rfind('-') + 1);
   std::error_code ec;
   for (const auto& e : fs::directory_iterator(parent, ec)) {
     const std::string name = e.path().filename().string();
@@ -136,8 +141,9 @@ void OutputFolder::Commit() {
   std::string old;
   if (fs::exists(fs::symlink_status(target_, ec)) && !IsEmptyFolder(target_)) {
     CheckOutputTarget(target_, flag_, existing_);  // it may have changed while we worked
-    old = (fs::path(target_).parent_path() / ("." + fs::path(target_).filename().string() + ".replaced-" +
-                                              ProcessTag())).string();
+    old = (fs::path(target_).parent_path() /
+           ("." + fs::path(target_).filename().string() + ".replaced-" + ProcessTag()))
+              .string();
     fs::rename(target_, old, ec);
     if (ec) throw std::runtime_error("cannot replace " + Quoted(target_) + ": " + ec.message());
   }
@@ -157,7 +163,8 @@ std::string CheckOutputFile(const std::string& path, const std::string& flag, bo
   const fs::file_status s = fs::symlink_status(p, ec);
   if (ec || !fs::exists(s)) return p;
   if (fs::is_symlink(s)) throw UsageError(flag + ": " + Quoted(p) + " is a symbolic link");
-  if (!fs::is_regular_file(s)) throw UsageError(flag + ": " + Quoted(p) + " exists and is not a file");
+  if (!fs::is_regular_file(s))
+    throw UsageError(flag + ": " + Quoted(p) + " exists and is not a file");
   if (!force) throw UsageError(flag + ": " + Quoted(p) + " exists (pass --force to replace it)");
   return p;
 }
@@ -172,7 +179,8 @@ void EnsureDirectory(const std::string& dir) {
 
 std::string TempFileName(const std::string& path) {
   const fs::path p(path);
-  return (p.parent_path() / ("." + p.stem().string() + ".partial-" + ProcessTag() + p.extension().string()))
+  return (p.parent_path() /
+          ("." + p.stem().string() + ".partial-" + ProcessTag() + p.extension().string()))
       .string();
 }
 

@@ -24,7 +24,8 @@ std::string Base64(const std::string& bytes) {
   std::string out;
   size_t i = 0;
   for (; i + 2 < bytes.size(); i += 3) {
-    const unsigned v = (unsigned char)bytes[i] << 16 | (unsigned char)bytes[i + 1] << 8 | (unsigned char)bytes[i + 2];
+    const unsigned v = (unsigned char)bytes[i] << 16 | (unsigned char)bytes[i + 1] << 8 |
+                       (unsigned char)bytes[i + 2];
     out += {k[v >> 18], k[(v >> 12) & 63], k[(v >> 6) & 63], k[v & 63]};
   }
   if (i + 1 == bytes.size()) {
@@ -40,10 +41,14 @@ std::string Base64(const std::string& bytes) {
 std::string Html(const std::string& s) {
   std::string o;
   for (const char c : s) {
-    if (c == '<') o += "&lt;";
-    else if (c == '>') o += "&gt;";
-    else if (c == '&') o += "&amp;";
-    else o += c;
+    if (c == '<')
+      o += "&lt;";
+    else if (c == '>')
+      o += "&gt;";
+    else if (c == '&')
+      o += "&amp;";
+    else
+      o += c;
   }
   return o;
 }
@@ -56,8 +61,8 @@ std::string Quoted(const std::string& s) {
 }
 
 std::string Img(const std::string& path, const std::string& alt) {
-  return "<figure><img src=\"data:image/png;base64," + Base64(ReadFile(path)) + "\" alt=\"" + Html(alt) +
-         "\"><figcaption>" + Html(alt) + "</figcaption></figure>\n";
+  return "<figure><img src=\"data:image/png;base64," + Base64(ReadFile(path)) + "\" alt=\"" +
+         Html(alt) + "\"><figcaption>" + Html(alt) + "</figcaption></figure>\n";
 }
 
 std::string Fmt(double v, const char* f = "%.4g") {
@@ -68,7 +73,8 @@ std::string Fmt(double v, const char* f = "%.4g") {
 
 const char* kStyle =
     "<style>body{font-family:sans-serif;margin:2em;max-width:1400px;color:#222}"
-    "table{border-collapse:collapse;font-size:13px}td,th{border:1px solid #ccc;padding:3px 8px;text-align:right}"
+    "table{border-collapse:collapse;font-size:13px}td,th{border:1px solid #ccc;padding:3px "
+    "8px;text-align:right}"
     "th{background:#f0f0f0}td.l,th.l{text-align:left}img{max-width:100%}figure{margin:1em 0}"
     "figcaption{font-size:13px;color:#555}.plots{display:flex;flex-wrap:wrap;gap:1em}"
     "h2{border-bottom:1px solid #ddd;padding-bottom:4px}</style>\n";
@@ -86,11 +92,13 @@ double Num(const nlohmann::json& j, const std::string& dotted) {
 
 std::string RunReport(const std::string& dir) {
   const nlohmann::json s = ReadJson(dir + "/summary.json");
-  std::string h = "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>FOVEA run: " + Html(dir) +
-                  "</title>" + kStyle + "</head><body>\n";
+  std::string h =
+      "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>FOVEA run: " + Html(dir) +
+      "</title>" + kStyle + "</head><body>\n";
   h += "<h1>FOVEA run</h1><p>Folder <code>" + Html(dir) + "</code>, scene <code>" +
-       Html(s.value("scene", std::string())) + "</code>, seed " + s.value("seed", nlohmann::json(0)).dump() +
-       ", method " + Html(s.value("method", std::string("fovea"))) + ".</p>\n";
+       Html(s.value("scene", std::string())) + "</code>, seed " +
+       s.value("seed", nlohmann::json(0)).dump() + ", method " +
+       Html(s.value("method", std::string("fovea"))) + ".</p>\n";
   h += "<h2>Figures</h2><table>";
   const std::vector<std::pair<std::string, std::string>> rows = {
       {"fixations", "fixations done"},
@@ -107,24 +115,29 @@ std::string RunReport(const std::string& dir) {
       {"wall_time_s", "wall time, s"}};
   for (const auto& [key, label] : rows) {
     const double v = Num(s, key);
-    if (std::isfinite(v)) h += "<tr><th class=l>" + Html(label) + "</th><td>" + Fmt(v) + "</td></tr>";
+    if (std::isfinite(v))
+      h += "<tr><th class=l>" + Html(label) + "</th><td>" + Fmt(v) + "</td></tr>";
   }
   h += "</table>\n";
   if (s.contains("by_level")) {
-    h += "<h3>By level</h3><table><tr><th class=l>level</th><th>share</th><th>median error, m</th><th>median "
+    h += "<h3>By level</h3><table><tr><th class=l>level</th><th>share</th><th>median error, "
+         "m</th><th>median "
          "error, steps</th><th>RMSE, m</th></tr>";
     for (auto it = s["by_level"].begin(); it != s["by_level"].end(); ++it)
-      h += "<tr><td class=l>" + it.key() + "</td><td>" + Fmt(Num(it.value(), "share")) + "</td><td>" +
-           Fmt(Num(it.value(), "median_abs_error_m")) + "</td><td>" + Fmt(Num(it.value(), "median_error_steps")) +
-           "</td><td>" + Fmt(Num(it.value(), "rmse_m")) + "</td></tr>";
+      h += "<tr><td class=l>" + it.key() + "</td><td>" + Fmt(Num(it.value(), "share")) +
+           "</td><td>" + Fmt(Num(it.value(), "median_abs_error_m")) + "</td><td>" +
+           Fmt(Num(it.value(), "median_error_steps")) + "</td><td>" +
+           Fmt(Num(it.value(), "rmse_m")) + "</td></tr>";
     h += "</table>\n";
   }
   if (s.contains("by_surface")) {
-    h += "<h3>By surface</h3><table><tr><th class=l>surface</th><th>pixels</th><th>coverage</th><th>foveal</th>"
+    h += "<h3>By surface</h3><table><tr><th "
+         "class=l>surface</th><th>pixels</th><th>coverage</th><th>foveal</th>"
          "<th>median error, m</th></tr>";
     for (auto it = s["by_surface"].begin(); it != s["by_surface"].end(); ++it)
-      h += "<tr><td class=l>" + Html(it.key()) + "</td><td>" + Fmt(Num(it.value(), "pixels"), "%.0f") + "</td><td>" +
-           Fmt(Num(it.value(), "coverage")) + "</td><td>" + Fmt(Num(it.value(), "foveal_coverage")) + "</td><td>" +
+      h += "<tr><td class=l>" + Html(it.key()) + "</td><td>" +
+           Fmt(Num(it.value(), "pixels"), "%.0f") + "</td><td>" + Fmt(Num(it.value(), "coverage")) +
+           "</td><td>" + Fmt(Num(it.value(), "foveal_coverage")) + "</td><td>" +
            Fmt(Num(it.value(), "median_abs_error_m")) + "</td></tr>";
     h += "</table>\n";
   }
@@ -145,7 +158,8 @@ std::string RunReport(const std::string& dir) {
   }
   if (!cov.x.empty()) {
     h += "<h2>Against fixation count</h2><div class=plots>";
-    h += GnuplotSvg("Coverage of the reference view", "fixation", "share of visible textured pixels", {cov, fov});
+    h += GnuplotSvg("Coverage of the reference view", "fixation",
+                    "share of visible textured pixels", {cov, fov});
     h += GnuplotSvg("Depth error", "fixation", "mm", {med, rmse}, true);
     h += "</div>\n";
   }
@@ -156,7 +170,8 @@ std::string RunReport(const std::string& dir) {
     if (fs::exists(dir + name)) h += Img(dir + name, "the map after fixation " + std::to_string(k));
   }
   if (fs::exists(dir + "/map.png")) h += Img(dir + "/map.png", "the map");
-  if (fs::exists(dir + "/fixation_path.png")) h += Img(dir + "/fixation_path.png", "the fixation path");
+  if (fs::exists(dir + "/fixation_path.png"))
+    h += Img(dir + "/fixation_path.png", "the fixation path");
   h += "</body></html>\n";
   return h;
 }
@@ -176,26 +191,37 @@ std::string SweepReport(const std::string& dir) {
       ++missing;
       continue;
     }
-    Row r{id, run.at("variant").get<std::string>(), "", {}, ReadJson(dir + "/runs/" + id + "/summary.json")};
-    for (auto it = run.at("point").begin(); it != run.at("point").end(); ++it) r.point[it.key()] = it.value();
+    Row r{id,
+          run.at("variant").get<std::string>(),
+          "",
+          {},
+          ReadJson(dir + "/runs/" + id + "/summary.json")};
+    for (auto it = run.at("point").begin(); it != run.at("point").end(); ++it)
+      r.point[it.key()] = it.value();
     for (const auto& p : run.at("config"))
       if (p.at(0) == "scene") r.scene = p.at(1).get<std::string>();
     rows.push_back(r);
   }
-  std::string h = "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>FOVEA sweep: " + Html(dir) +
-                  "</title>" + kStyle + "</head><body>\n<h1>FOVEA sweep</h1>\n";
-  h += "<p>Folder <code>" + Html(dir) + "</code>: " + std::to_string(rows.size()) + " runs with results" +
+  std::string h =
+      "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>FOVEA sweep: " + Html(dir) +
+      "</title>" + kStyle + "</head><body>\n<h1>FOVEA sweep</h1>\n";
+  h += "<p>Folder <code>" + Html(dir) + "</code>: " + std::to_string(rows.size()) +
+       " runs with results" +
        (missing ? ", " + std::to_string(missing) + " without" : std::string()) +
        ". Data: <code>results.csv</code> (a row per run). Axes:</p><ul>";
   for (const auto& a : grid.at("axes")) {
     std::string values;
-    for (const auto& v : a.at("values")) values += (values.empty() ? "" : ", ") + v.get<std::string>();
-    h += "<li><code>" + Html(a.at("path").get<std::string>()) + "</code>: " + Html(values) + "</li>";
+    for (const auto& v : a.at("values"))
+      values += (values.empty() ? "" : ", ") + v.get<std::string>();
+    h +=
+        "<li><code>" + Html(a.at("path").get<std::string>()) + "</code>: " + Html(values) + "</li>";
   }
   std::string baselines;
-  for (const auto& b : grid.at("baselines")) baselines += (baselines.empty() ? "" : ", ") + b.get<std::string>();
+  for (const auto& b : grid.at("baselines"))
+    baselines += (baselines.empty() ? "" : ", ") + b.get<std::string>();
   h += "</ul><p>Baselines: " + (baselines.empty() ? std::string("none") : Html(baselines)) +
-       " (static_sgbm: StereoSGBM on the static parallel pair; deterministic: always the composite's maximum).</p>\n";
+       " (static_sgbm: StereoSGBM on the static parallel pair; deterministic: always the "
+       "composite's maximum).</p>\n";
 
   const std::vector<std::pair<std::string, std::string>> figures = {
       {"coverage", "coverage"},
@@ -217,9 +243,12 @@ std::string SweepReport(const std::string& dir) {
       numeric &= end && *end == '\0' && !t.empty();
     }
     if (!numeric || xs.size() < 2) continue;
-    const double x_min = *std::min_element(xs.begin(), xs.end()), x_max = *std::max_element(xs.begin(), xs.end());
-    h += "<h2>Against <code>" + Html(path) + "</code></h2><p>A line per scene and variant: the mean over the "
-         "other axes (seeds, ...), bars from the smallest to the largest value. Baselines that do not depend "
+    const double x_min = *std::min_element(xs.begin(), xs.end()),
+                 x_max = *std::max_element(xs.begin(), xs.end());
+    h += "<h2>Against <code>" + Html(path) +
+         "</code></h2><p>A line per scene and variant: the mean over the "
+         "other axes (seeds, ...), bars from the smallest to the largest value. Baselines that do "
+         "not depend "
          "on this parameter are dashed horizontal lines.</p><div class=plots>\n";
     for (const auto& [key, label] : figures) {
       // (scene, variant) -> x -> values
@@ -229,8 +258,10 @@ std::string SweepReport(const std::string& dir) {
         const double v = Num(r.summary, key);
         if (!std::isfinite(v)) continue;
         const auto it = r.point.find(path);
-        if (it != r.point.end()) groups[{r.scene, r.variant}][std::strtod(it->second.c_str(), nullptr)].push_back(v);
-        else flat[{r.scene, r.variant}].push_back(v);
+        if (it != r.point.end())
+          groups[{r.scene, r.variant}][std::strtod(it->second.c_str(), nullptr)].push_back(v);
+        else
+          flat[{r.scene, r.variant}].push_back(v);
       }
       std::vector<Series> series;
       for (const auto& [g, by_x] : groups) {
@@ -262,14 +293,17 @@ std::string SweepReport(const std::string& dir) {
   h += "<h2>Runs</h2><table><tr><th class=l>run</th><th class=l>variant</th>";
   std::set<std::string> axis_names;
   for (const auto& a : grid.at("axes")) axis_names.insert(a.at("path").get<std::string>());
-  for (const auto& a : grid.at("axes")) h += "<th class=l>" + Html(a.at("path").get<std::string>()) + "</th>";
+  for (const auto& a : grid.at("axes"))
+    h += "<th class=l>" + Html(a.at("path").get<std::string>()) + "</th>";
   for (const auto& [key, label] : figures) h += "<th>" + Html(label) + "</th>";
   h += "</tr>\n";
   for (const Row& r : rows) {
-    h += "<tr><td class=l><a href=\"runs/" + r.id + "/\">" + r.id + "</a></td><td class=l>" + r.variant + "</td>";
+    h += "<tr><td class=l><a href=\"runs/" + r.id + "/\">" + r.id + "</a></td><td class=l>" +
+         r.variant + "</td>";
     for (const auto& a : grid.at("axes")) {
       const auto it = r.point.find(a.at("path").get<std::string>());
-      h += "<td class=l>" + (it == r.point.end() ? std::string("(base)") : Html(it->second)) + "</td>";
+      h += "<td class=l>" + (it == r.point.end() ? std::string("(base)") : Html(it->second)) +
+           "</td>";
     }
     for (const auto& [key, label] : figures) h += "<td>" + Fmt(Num(r.summary, key)) + "</td>";
     h += "</tr>\n";
@@ -280,21 +314,25 @@ std::string SweepReport(const std::string& dir) {
 
 }  // namespace
 
-std::string GnuplotSvg(const std::string& title, const std::string& xlabel, const std::string& ylabel,
-                       const std::vector<Series>& series, bool log_y) {
-  const std::string base = (fs::temp_directory_path() / ("fovea_plot_" + std::to_string(getpid()))).string();
+std::string GnuplotSvg(const std::string& title, const std::string& xlabel,
+                       const std::string& ylabel, const std::vector<Series>& series, bool log_y) {
+  const std::string base =
+      (fs::temp_directory_path() / ("fovea_plot_" + std::to_string(getpid()))).string();
   std::ostringstream gp;
   gp << "set terminal svg size 560,380 fixed noenhanced font 'sans,11' background rgb 'white'\n"
      << "set output " << Quoted(base + ".svg") << "\n"
-     << "set title " << Quoted(title) << "\nset xlabel " << Quoted(xlabel) << "\nset ylabel " << Quoted(ylabel)
-     << "\nset key outside below\nset grid\nset offsets graph 0.03, graph 0.03, graph 0.05, graph 0.05\n";
+     << "set title " << Quoted(title) << "\nset xlabel " << Quoted(xlabel) << "\nset ylabel "
+     << Quoted(ylabel)
+     << "\nset key outside below\nset grid\nset offsets graph 0.03, graph 0.03, graph 0.05, graph "
+        "0.05\n";
   if (log_y) gp << "set logscale y\n";
   std::string plot = "plot ";
   for (size_t i = 0; i < series.size(); ++i) {
     const Series& s = series[i];
     const bool bars = !s.y_lo.empty();
-    plot += std::string(i ? ", " : "") + "'-' using 1:2" + (bars ? ":3:4 with yerrorlines" : " with linespoints") +
-            " lw 1.5 pt 7 ps 0.6" + (s.dashed ? " dt 2" : "") + " title " + Quoted(s.title);
+    plot += std::string(i ? ", " : "") + "'-' using 1:2" +
+            (bars ? ":3:4 with yerrorlines" : " with linespoints") + " lw 1.5 pt 7 ps 0.6" +
+            (s.dashed ? " dt 2" : "") + " title " + Quoted(s.title);
   }
   gp << plot << "\n";
   for (const Series& s : series) {
@@ -325,9 +363,13 @@ std::string GnuplotSvg(const std::string& title, const std::string& xlabel, cons
 
 std::string WriteReport(const std::string& dir) {
   std::string page;
-  if (fs::exists(dir + "/grid.json")) page = SweepReport(dir);
-  else if (fs::exists(dir + "/summary.json")) page = RunReport(dir);
-  else throw UsageError("'" + dir + "' is neither a run folder (summary.json) nor a sweep folder (grid.json)");
+  if (fs::exists(dir + "/grid.json"))
+    page = SweepReport(dir);
+  else if (fs::exists(dir + "/summary.json"))
+    page = RunReport(dir);
+  else
+    throw UsageError("'" + dir +
+                     "' is neither a run folder (summary.json) nor a sweep folder (grid.json)");
   WriteTextAtomic(dir + "/report.html", page);
   return dir + "/report.html";
 }

@@ -19,8 +19,9 @@ struct Series {
 
 /// A plot drawn by gnuplot (`gnuplot` on the PATH) as SVG text. Throws
 /// std::runtime_error when gnuplot is missing or fails.
-std::string GnuplotSvg(const std::string& title, const std::string& xlabel, const std::string& ylabel,
-                       const std::vector<Series>& series, bool log_y = false);
+std::string GnuplotSvg(const std::string& title, const std::string& xlabel,
+                       const std::string& ylabel, const std::vector<Series>& series,
+                       bool log_y = false);
 
 /// Writes DIR/report.html for a run folder (summary.json) or a sweep folder
 /// (grid.json and results.csv); returns its path. Throws UsageError when DIR

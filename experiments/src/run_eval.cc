@@ -46,7 +46,8 @@ bool RightCameraSees(const rig::RigGeometry& geometry, const std::vector<double>
   constexpr double kOnSurfaceShare = 0.005;
   for (const double s : carriages) {
     const Eigen::Vector3d c =
-        geometry.WorldFromCamera(rig::Side::kRight, geometry.FacingStage(rig::Side::kRight, s, p_W)).translation();
+        geometry.WorldFromCamera(rig::Side::kRight, geometry.FacingStage(rig::Side::kRight, s, p_W))
+            .translation();
     const Eigen::Vector3d d = p_W - c;
     const double distance = d.norm();
     const auto hit = truth.CastRay(c, d / distance);
@@ -78,17 +79,18 @@ ReferenceView MakeReferenceView(rig::Rig& rig, const sim::GroundTruth& truth) {
   // decide the rest.
   constexpr double kDepthShare = 0.01;
   const double mean_depth = cv::mean(ref.depth_m, ref.textured)[0];
-  const Eigen::Vector3d centre_W = ref.view.world_T_camera * Eigen::Vector3d(0, 0, mean_depth > 0 ? mean_depth : 1);
-  const rig::CameraIntrinsics wide =
-      rig::CameraIntrinsics::FromHorizontalFov(ref.view.intrinsics.width_px, ref.view.intrinsics.height_px, M_PI / 3);
+  const Eigen::Vector3d centre_W =
+      ref.view.world_T_camera * Eigen::Vector3d(0, 0, mean_depth > 0 ? mean_depth : 1);
+  const rig::CameraIntrinsics wide = rig::CameraIntrinsics::FromHorizontalFov(
+      ref.view.intrinsics.width_px, ref.view.intrinsics.height_px, M_PI / 3);
   struct Seen {
     Eigen::Isometry3d camera_T_world;
     cv::Mat depth_m;
   };
   std::vector<Seen> renders;
   for (const double s : carriages) {
-    const Eigen::Isometry3d world_T_camera =
-        geometry.WorldFromCamera(rig::Side::kRight, geometry.FacingStage(rig::Side::kRight, s, centre_W));
+    const Eigen::Isometry3d world_T_camera = geometry.WorldFromCamera(
+        rig::Side::kRight, geometry.FacingStage(rig::Side::kRight, s, centre_W));
     renders.push_back({world_T_camera.inverse(), truth.Render(world_T_camera, wide).depth_m});
   }
   auto rendered = [&](const Eigen::Vector3d& p_W) {
@@ -109,14 +111,15 @@ ReferenceView MakeReferenceView(rig::Rig& rig, const sim::GroundTruth& truth) {
       if (!ref.textured.at<uchar>(y, x) || z <= 0) continue;
       const fovea::Ray ray = fovea::PixelRay(ref.view.world_T_camera, ref.view.intrinsics, {x, y});
       const Eigen::Vector3d p = ray.origin_W + ray.direction_W * (z / ray.direction_W.dot(axis));
-      if (rendered(p) || RightCameraSees(geometry, carriages, truth, p)) ref.stereo_visible.at<uchar>(y, x) = 255;
+      if (rendered(p) || RightCameraSees(geometry, carriages, truth, p))
+        ref.stereo_visible.at<uchar>(y, x) = 255;
     }
   ref.stereo_visible_pixels = cv::countNonZero(ref.stereo_visible);
   return ref;
 }
 
-MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref, const sim::GroundTruth& truth,
-                  double baseline_m, bool per_patch) {
+MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref,
+                  const sim::GroundTruth& truth, double baseline_m, bool per_patch) {
   MapScore s;
   cv::Mat depth, ids;
   map.Render(ref.view.world_T_camera, ref.view.intrinsics, &depth, &ids);
@@ -194,7 +197,9 @@ MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref, const si
 
 namespace {
 // A figure over `pixels` values: null when there were none.
-nlohmann::json Figure(long pixels, double value) { return pixels > 0 ? nlohmann::json(value) : nlohmann::json(); }
+nlohmann::json Figure(long pixels, double value) {
+  return pixels > 0 ? nlohmann::json(value) : nlohmann::json();
+}
 
 nlohmann::json ErrorJson(const ErrorFigures& f) {
   return {{"pixels", f.pixels},
@@ -222,7 +227,8 @@ nlohmann::json ScoreJson(const MapScore& s) {
   j["within_1pct"] = Figure(n, s.overall.within_1pct);
   j["median_error_steps"] = Figure(n, s.overall.median_error_steps);
   for (int i = 0; i < 3; ++i)
-    j["by_level"][fovea::PatchLevelName(static_cast<fovea::PatchLevel>(i))] = ErrorJson(s.by_level[i]);
+    j["by_level"][fovea::PatchLevelName(static_cast<fovea::PatchLevel>(i))] =
+        ErrorJson(s.by_level[i]);
   for (const SurfaceFigures& sf : s.surfaces)
     j["by_surface"][sf.name] = {{"pixels", sf.pixels},
                                 {"coverage", sf.coverage},
@@ -243,15 +249,17 @@ std::string ScoreLine(const MapScore& s, bool brief) {
   char line[256];
   const ErrorFigures& e = s.overall;
   if (e.pixels == 0) {
-    std::snprintf(line, sizeof line, "coverage %.3f, foveal %.3f, median error - (no mapped pixel)", s.coverage,
-                  s.foveal_coverage);
+    std::snprintf(line, sizeof line, "coverage %.3f, foveal %.3f, median error - (no mapped pixel)",
+                  s.coverage, s.foveal_coverage);
   } else if (brief) {
     std::snprintf(line, sizeof line, "coverage %.3f, foveal %.3f, median error %.2f mm", s.coverage,
                   s.foveal_coverage, 1e3 * e.median_abs_error_m);
   } else {
-    std::snprintf(line, sizeof line, "coverage %.3f, foveal %.3f, median error %.2f mm (%.3f%% of depth), RMSE %.2f mm",
-                  s.coverage, s.foveal_coverage, 1e3 * e.median_abs_error_m, 100 * e.median_rel_error,
-                  1e3 * e.rmse_m);
+    std::snprintf(
+        line, sizeof line,
+        "coverage %.3f, foveal %.3f, median error %.2f mm (%.3f%% of depth), RMSE %.2f mm",
+        s.coverage, s.foveal_coverage, 1e3 * e.median_abs_error_m, 100 * e.median_rel_error,
+        1e3 * e.rmse_m);
   }
   return line;
 }

@@ -15,10 +15,10 @@ namespace experiments {
 
 /// The reference view and its truth.
 struct ReferenceView {
-  rig::CameraView view;   ///< left camera at home: image, pose, intrinsics
-  cv::Mat depth_m;        ///< true planar depth (CV_32F, 0 = nothing)
-  cv::Mat geom_ids;       ///< surface per pixel (CV_32S, -1 = nothing)
-  cv::Mat textured;       ///< CV_8U, 255 where a textured surface is visible
+  rig::CameraView view;  ///< left camera at home: image, pose, intrinsics
+  cv::Mat depth_m;       ///< true planar depth (CV_32F, 0 = nothing)
+  cv::Mat geom_ids;      ///< surface per pixel (CV_32S, -1 = nothing)
+  cv::Mat textured;      ///< CV_8U, 255 where a textured surface is visible
   long textured_pixels = 0;
   /// CV_8U, 255 at the textured pixels whose true point the right camera's
   /// optical centre has in sight from some carriage position (kStereoPositions
@@ -39,27 +39,29 @@ constexpr int kStereoPositions = 8;
 ReferenceView MakeReferenceView(rig::Rig& rig, const sim::GroundTruth& truth);
 
 struct ErrorFigures {
-  long pixels = 0;                 ///< mapped textured pixels scored
-  double share = 0;                ///< of the visible textured pixels
+  long pixels = 0;   ///< mapped textured pixels scored
+  double share = 0;  ///< of the visible textured pixels
   double median_abs_error_m = 0, mean_abs_error_m = 0, rmse_m = 0;
-  double median_rel_error = 0;     ///< |Z - Z_true| / Z_true
-  double within_1pct = 0;          ///< share of scored pixels within 1% of depth
-  double median_error_steps = 0;   ///< in disparity steps Z^2 / (f B) at the vergent baseline
+  double median_rel_error = 0;    ///< |Z - Z_true| / Z_true
+  double within_1pct = 0;         ///< share of scored pixels within 1% of depth
+  double median_error_steps = 0;  ///< in disparity steps Z^2 / (f B) at the vergent baseline
 };
 
 struct SurfaceFigures {
   std::string name;
-  long pixels = 0;                 ///< visible textured pixels of the surface
+  long pixels = 0;  ///< visible textured pixels of the surface
   double coverage = 0, foveal_coverage = 0;
   double stereo_visible_share = 0;  ///< of its pixels, those in ReferenceView::stereo_visible
-  double median_abs_error_m = 0, median_rel_error = 0, median_error_steps = 0, rmse_m = 0;  ///< 0 when unmapped
-  long mapped = 0;                 ///< of its pixels, those with an estimate
+  double median_abs_error_m = 0, median_rel_error = 0, median_error_steps = 0,
+         rmse_m = 0;  ///< 0 when unmapped
+  long mapped = 0;    ///< of its pixels, those with an estimate
 };
 
 struct MapScore {
-  double coverage = 0;             ///< share of visible textured pixels with an estimate
-  double foveal_coverage = 0;      ///< ... with a foveal estimate
-  double stereo_visible_share = 0;     ///< of the visible textured pixels, those in ReferenceView::stereo_visible
+  double coverage = 0;         ///< share of visible textured pixels with an estimate
+  double foveal_coverage = 0;  ///< ... with a foveal estimate
+  double stereo_visible_share =
+      0;  ///< of the visible textured pixels, those in ReferenceView::stereo_visible
   double stereo_visible_coverage = 0;  ///< share of those with an estimate
   ErrorFigures overall;
   std::array<ErrorFigures, 3> by_level;  ///< by PatchLevel of the patch seen
@@ -72,8 +74,8 @@ struct MapScore {
 };
 
 /// Scores `map` in the reference view; `baseline_m` sets the disparity step.
-MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref, const sim::GroundTruth& truth,
-                  double baseline_m, bool per_patch);
+MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref,
+                  const sim::GroundTruth& truth, double baseline_m, bool per_patch);
 
 /// The figures as summary.json holds them. Error figures over no pixel (an
 /// empty map, an unmapped level or surface) are null, not zero.

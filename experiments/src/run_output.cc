@@ -13,9 +13,12 @@ namespace experiments {
 
 cv::Scalar LevelColor(fovea::PatchLevel level) {
   switch (level) {
-    case fovea::PatchLevel::kIdr: return {170, 170, 170};
-    case fovea::PatchLevel::kPeripheral: return {230, 130, 50};
-    case fovea::PatchLevel::kFoveal: return {40, 110, 240};
+    case fovea::PatchLevel::kIdr:
+      return {170, 170, 170};
+    case fovea::PatchLevel::kPeripheral:
+      return {230, 130, 50};
+    case fovea::PatchLevel::kFoveal:
+      return {40, 110, 240};
   }
   return {255, 255, 255};
 }
@@ -24,15 +27,16 @@ std::string PatchMapPly(const fovea::PatchMap& map) {
   std::ostringstream out;
   out << "ply\nformat ascii 1.0\ncomment FOVEA patch map: one quad per patch, colour by level "
          "(grey IDR, blue peripheral, orange foveal)\n"
-      << "element vertex " << 4 * map.size() << "\nproperty float x\nproperty float y\nproperty float z\n"
+      << "element vertex " << 4 * map.size()
+      << "\nproperty float x\nproperty float y\nproperty float z\n"
       << "property uchar red\nproperty uchar green\nproperty uchar blue\n"
       << "element face " << map.size() << "\nproperty list uchar int vertex_indices\nend_header\n";
   char line[160];
   for (const fovea::Patch& p : map.patches()) {
     const cv::Scalar c = LevelColor(p.level);
     for (const Eigen::Vector3d& v : p.corners_W) {
-      std::snprintf(line, sizeof line, "%.6f %.6f %.6f %d %d %d\n", v.x(), v.y(), v.z(), int(c[2]), int(c[1]),
-                    int(c[0]));
+      std::snprintf(line, sizeof line, "%.6f %.6f %.6f %d %d %d\n", v.x(), v.y(), v.z(), int(c[2]),
+                    int(c[1]), int(c[0]));
       out << line;
     }
   }
@@ -45,8 +49,9 @@ cv::Mat ObliqueView(const fovea::PatchMap& map, const Eigen::Vector3d& target_W,
   // Eye in front of the scene, to the left and above, looking at the target.
   const double az = 40 * M_PI / 180, el = 30 * M_PI / 180;
   const double dist = 1.1 * std::max(0.5, target_W.norm());
-  const Eigen::Vector3d eye = target_W + dist * Eigen::Vector3d(-std::sin(az) * std::cos(el),
-                                                                -std::cos(az) * std::cos(el), std::sin(el));
+  const Eigen::Vector3d eye =
+      target_W + dist * Eigen::Vector3d(-std::sin(az) * std::cos(el), -std::cos(az) * std::cos(el),
+                                        std::sin(el));
   const Eigen::Vector3d z = (target_W - eye).normalized();
   const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
   const Eigen::Vector3d y = z.cross(x);
@@ -69,9 +74,9 @@ cv::Mat ObliqueView(const fovea::PatchMap& map, const Eigen::Vector3d& target_W,
       if (id < 0) continue;
       const double shade = 0.35 + 0.65 * std::abs(map[id].Normal().dot(light));
       const cv::Scalar c = LevelColor(map[id].level);
-      img.at<cv::Vec3b>(v, u) = cv::Vec3b(cv::saturate_cast<uchar>(c[0] * shade),
-                                          cv::saturate_cast<uchar>(c[1] * shade),
-                                          cv::saturate_cast<uchar>(c[2] * shade));
+      img.at<cv::Vec3b>(v, u) =
+          cv::Vec3b(cv::saturate_cast<uchar>(c[0] * shade), cv::saturate_cast<uchar>(c[1] * shade),
+                    cv::saturate_cast<uchar>(c[2] * shade));
     }
   // Patch outlines: draw the edges so that patch sizes show.
   for (int v = 1; v < h; ++v)
@@ -95,8 +100,8 @@ cv::Mat PatchDepthBesideTruth(const fovea::PatchMap& map, const rig::CameraView&
   return side;
 }
 
-cv::Mat MapSnapshot(const fovea::PatchMap& map, const ReferenceView& ref, const Eigen::Vector3d& target_W,
-                    const std::string& caption) {
+cv::Mat MapSnapshot(const fovea::PatchMap& map, const ReferenceView& ref,
+                    const Eigen::Vector3d& target_W, const std::string& caption) {
   const int w = ref.view.intrinsics.width_px, h = ref.view.intrinsics.height_px;
   cv::Mat depth;
   map.Render(ref.view.world_T_camera, ref.view.intrinsics, &depth, nullptr);
@@ -112,8 +117,8 @@ cv::Mat MapSnapshot(const fovea::PatchMap& map, const ReferenceView& ref, const 
   const char* labels[3] = {"patches, oblique view (grey IDR, blue peripheral, orange foveal)",
                            "map depth, reference view", "true depth"};
   for (int i = 0; i < 3; ++i)
-    cv::putText(out, labels[i], {i * w + 8, 28 + h - 10}, cv::FONT_HERSHEY_SIMPLEX, 0.45, {255, 255, 255}, 1,
-                cv::LINE_AA);
+    cv::putText(out, labels[i], {i * w + 8, 28 + h - 10}, cv::FONT_HERSHEY_SIMPLEX, 0.45,
+                {255, 255, 255}, 1, cv::LINE_AA);
   return out;
 }
 
@@ -124,7 +129,8 @@ cv::Mat FixationPath(const ReferenceView& ref, const std::vector<Eigen::Vector3d
   auto project = [&](const Eigen::Vector3d& p) -> std::optional<cv::Point> {
     const auto uv = fovea::ProjectWorldPoint(ref.view.world_T_camera, ref.view.intrinsics, p);
     if (!uv) return std::nullopt;
-    return cv::Point(static_cast<int>(std::lround(uv->x())), static_cast<int>(std::lround(uv->y())));
+    return cv::Point(static_cast<int>(std::lround(uv->x())),
+                     static_cast<int>(std::lround(uv->y())));
   };
   std::optional<cv::Point> prev;
   const int n = static_cast<int>(fixations_W.size());
@@ -143,8 +149,8 @@ cv::Mat FixationPath(const ReferenceView& ref, const std::vector<Eigen::Vector3d
     if (!p) continue;
     cv::circle(img, *p, 5, {0, 0, 0}, cv::FILLED, cv::LINE_AA);
     cv::circle(img, *p, 4, {0, 255, 255}, cv::FILLED, cv::LINE_AA);
-    cv::putText(img, std::to_string(i + 1), *p + cv::Point(6, -6), cv::FONT_HERSHEY_SIMPLEX, 0.45, {0, 0, 0}, 3,
-                cv::LINE_AA);
+    cv::putText(img, std::to_string(i + 1), *p + cv::Point(6, -6), cv::FONT_HERSHEY_SIMPLEX, 0.45,
+                {0, 0, 0}, 3, cv::LINE_AA);
     cv::putText(img, std::to_string(i + 1), *p + cv::Point(6, -6), cv::FONT_HERSHEY_SIMPLEX, 0.45,
                 {255, 255, 255}, 1, cv::LINE_AA);
   }

@@ -21,7 +21,8 @@ std::string PatchMapPly(const fovea::PatchMap& map);
 /// The patches rendered from an oblique virtual camera that looks at
 /// `target_W` from the front left and above, shaded by their normals and
 /// coloured by level.
-cv::Mat ObliqueView(const fovea::PatchMap& map, const Eigen::Vector3d& target_W, int width_px, int height_px);
+cv::Mat ObliqueView(const fovea::PatchMap& map, const Eigen::Vector3d& target_W, int width_px,
+                    int height_px);
 
 /// The map's depth seen by `view` beside the true depth there, one colour
 /// scale (the true depth's range).
@@ -31,8 +32,8 @@ cv::Mat PatchDepthBesideTruth(const fovea::PatchMap& map, const rig::CameraView&
 /// The map after a fixation as the paper shows it: the oblique view, the
 /// map's depth in the reference view and the true depth (same colours), with
 /// a caption.
-cv::Mat MapSnapshot(const fovea::PatchMap& map, const ReferenceView& ref, const Eigen::Vector3d& target_W,
-                    const std::string& caption);
+cv::Mat MapSnapshot(const fovea::PatchMap& map, const ReferenceView& ref,
+                    const Eigen::Vector3d& target_W, const std::string& caption);
 
 /// The reference image with the fixation points, numbered and joined in
 /// order (refused points as crosses).

@@ -16,8 +16,9 @@ void SceneOptions::Register(CLI::App* cmd, bool with_state) {
     auto* s = cmd->add_option("--state", state,
                               "stage state: left baseline m, left pan deg, left tilt deg, right "
                               "baseline m, right pan deg, right tilt deg (comma separated)");
-    auto* b = cmd->add_option("--baseline", baseline, "parallel, level cameras this far apart (metres)")
-                  ->check(NumberIn(1e-4, 10));
+    auto* b =
+        cmd->add_option("--baseline", baseline, "parallel, level cameras this far apart (metres)")
+            ->check(NumberIn(1e-4, 10));
     s->excludes(b);
   }
 }
@@ -33,7 +34,8 @@ std::optional<rig::StageState> SceneOptions::TargetState() const {
   if (state.empty()) return std::nullopt;
   const std::vector<std::string> fields = SplitFields(state);
   if (fields.size() != rig::kNumAxes)
-    throw UsageError("--state needs exactly 6 comma-separated numbers, got '" + rig::ClipForMessage(state) + "'");
+    throw UsageError("--state needs exactly 6 comma-separated numbers, got '" +
+                     rig::ClipForMessage(state) + "'");
   std::array<double, rig::kNumAxes> v{};
   for (int i = 0; i < rig::kNumAxes; ++i) {
     const std::optional<double> x = ParseNumber(fields[i]);
@@ -51,9 +53,12 @@ std::unique_ptr<sim::Simulation> LoadSceneOf(const RunConfig& config) {
 }
 
 void AddForceFlag(CLI::App* cmd, bool* force) {
-  cmd->add_flag("--force", *force, "replace an earlier result of fovea at --out (never anything else)");
+  cmd->add_flag("--force", *force,
+                "replace an earlier result of fovea at --out (never anything else)");
 }
 
-ExistingOutput ExistingPolicy(bool force) { return force ? ExistingOutput::kReplace : ExistingOutput::kRefuse; }
+ExistingOutput ExistingPolicy(bool force) {
+  return force ? ExistingOutput::kReplace : ExistingOutput::kRefuse;
+}
 
 }  // namespace experiments

@@ -3,11 +3,11 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
-#include <optional>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -17,8 +17,6 @@
 namespace experiments {
 namespace fs = std::filesystem;
 namespace {
-
-
 
 std::string Number(double v) {
   char buf[40];
@@ -39,19 +37,23 @@ std::vector<std::string> AxisValues(const YAML::Node& node, const std::string& w
     for (const auto& kv : node) {
       const std::string key = kv.first.as<std::string>();
       if (key != "from" && key != "to" && key != "step" && key != "count")
-        throw UsageError(where + "unknown range key '" + key + "' (expected from, to, step or count)");
-      const std::optional<double> v = kv.second.IsScalar() ? ParseNumber(kv.second.Scalar()) : std::nullopt;
+        throw UsageError(where + "unknown range key '" + key +
+                         "' (expected from, to, step or count)");
+      const std::optional<double> v =
+          kv.second.IsScalar() ? ParseNumber(kv.second.Scalar()) : std::nullopt;
       if (!v) throw UsageError(where + "range key '" + key + "': expected a number");
       r[key] = *v;
     }
     if (!r.count("from") || !r.count("to")) throw UsageError(where + "a range needs from and to");
-    if (r.count("step") == r.count("count")) throw UsageError(where + "a range needs exactly one of step or count");
+    if (r.count("step") == r.count("count"))
+      throw UsageError(where + "a range needs exactly one of step or count");
     const double from = r["from"], to = r["to"];
     int n;
     double step;
     if (r.count("count")) {
       if (!(r["count"] >= 1 && r["count"] <= kMaxSweepRuns && r["count"] == std::floor(r["count"])))
-        throw UsageError(where + "range count must be a whole number from 1 to " + std::to_string(kMaxSweepRuns));
+        throw UsageError(where + "range count must be a whole number from 1 to " +
+                         std::to_string(kMaxSweepRuns));
       n = static_cast<int>(r["count"]);
       step = n > 1 ? (to - from) / (n - 1) : 0;
     } else {
@@ -59,7 +61,9 @@ std::vector<std::string> AxisValues(const YAML::Node& node, const std::string& w
       if (!(step > 0)) throw UsageError(where + "range step must be positive");
       if (to < from) throw UsageError(where + "range needs from <= to");
       const double k = std::floor((to - from) / step + 1e-9);
-      if (k + 1 > kMaxSweepRuns) throw UsageError(where + "range has more than " + std::to_string(kMaxSweepRuns) + " values");
+      if (k + 1 > kMaxSweepRuns)
+        throw UsageError(where + "range has more than " + std::to_string(kMaxSweepRuns) +
+                         " values");
       n = static_cast<int>(k) + 1;
     }
     for (int i = 0; i < n; ++i) values.push_back(Number(from + i * step));
@@ -90,8 +94,8 @@ std::string Variant(const RunConfig& c) {
 
 // Axes a static baseline keeps (the rest do not concern it).
 bool ConcernsStatic(const std::string& path) {
-  return path == "scene" || path == "seed" || path.rfind("rig.", 0) == 0 || path.rfind("static.", 0) == 0 ||
-         path == "idr.z_min_m" || path == "foveal.fovea_patch_px";
+  return path == "scene" || path == "seed" || path.rfind("rig.", 0) == 0 ||
+         path.rfind("static.", 0) == 0 || path == "idr.z_min_m" || path == "foveal.fovea_patch_px";
 }
 
 }  // namespace
@@ -109,7 +113,8 @@ Sweep LoadSweep(const std::string& path) {
 Sweep ParseSweep(const std::string& text, const std::string& path) {
   const std::string where = "sweep " + rig::ClipForMessage(path) + ": ";
   const YAML::Node root = ParseYaml(text, where);
-  if (!root.IsMap()) throw UsageError(where + "expected a mapping with base, config, axes, baselines, jobs");
+  if (!root.IsMap())
+    throw UsageError(where + "expected a mapping with base, config, axes, baselines, jobs");
   Sweep sweep;
   sweep.file = path;
   RunConfig base;
@@ -126,11 +131,13 @@ Sweep ParseSweep(const std::string& text, const std::string& path) {
     base = LoadConfig(b.string());
   }
   if (root["config"]) {
-    if (!root["config"].IsMap()) throw UsageError(where + "key 'config': expected a mapping of parameters");
+    if (!root["config"].IsMap())
+      throw UsageError(where + "key 'config': expected a mapping of parameters");
     ApplyYaml(root["config"], &base, where + "config: ");
   }
   if (root["jobs"]) {
-    const std::optional<double> jobs = root["jobs"].IsScalar() ? ParseNumber(root["jobs"].Scalar()) : std::nullopt;
+    const std::optional<double> jobs =
+        root["jobs"].IsScalar() ? ParseNumber(root["jobs"].Scalar()) : std::nullopt;
     if (!jobs || *jobs != std::floor(*jobs) || *jobs < 0 || *jobs > 1024)
       throw UsageError(where + "key 'jobs': expected a whole number in [0, 1024] (0 = every core)");
     sweep.jobs = static_cast<int>(*jobs);
@@ -160,11 +167,13 @@ Sweep ParseSweep(const std::string& text, const std::string& path) {
       if (axis.path == "scene") CheckScene(v, where + "axes: key 'scene': ");
     }
     for (const SweepAxis& a : sweep.axes)
-      if (a.path == axis.path) throw UsageError(where + "axes: key '" + axis.path + "' appears twice");
+      if (a.path == axis.path)
+        throw UsageError(where + "axes: key '" + axis.path + "' appears twice");
     sweep.axes.push_back(axis);
   }
   if (root["baselines"]) {
-    if (!root["baselines"].IsSequence()) throw UsageError(where + "key 'baselines': expected a list");
+    if (!root["baselines"].IsSequence())
+      throw UsageError(where + "key 'baselines': expected a list");
     for (const auto& b : root["baselines"]) {
       const std::string name = b.IsScalar() ? b.Scalar() : "";
       if (name != "deterministic" && name != "static_sgbm")
@@ -183,7 +192,8 @@ Sweep ParseSweep(const std::string& text, const std::string& path) {
                        " runs (the limit of one sweep; split it into several)");
   }
   std::set<std::string> seen;
-  auto add = [&](const RunConfig& c, const std::vector<std::pair<std::string, std::string>>& point) {
+  auto add = [&](const RunConfig& c,
+                 const std::vector<std::pair<std::string, std::string>>& point) {
     RunConfig config = c;
     if (config.scene.empty()) config.scene = scenes::kDefaultScene;
     try {
@@ -201,7 +211,8 @@ Sweep ParseSweep(const std::string& text, const std::string& path) {
   std::vector<size_t> index(sweep.axes.size(), 0);
   for (long i = 0; i < total; ++i) {
     std::vector<std::pair<std::string, std::string>> point;
-    for (size_t a = 0; a < sweep.axes.size(); ++a) point.emplace_back(sweep.axes[a].path, sweep.axes[a].values[index[a]]);
+    for (size_t a = 0; a < sweep.axes.size(); ++a)
+      point.emplace_back(sweep.axes[a].path, sweep.axes[a].values[index[a]]);
     points.push_back(point);
     for (size_t a = sweep.axes.size(); a-- > 0;) {
       if (++index[a] < sweep.axes[a].values.size()) break;
@@ -222,8 +233,10 @@ Sweep ParseSweep(const std::string& text, const std::string& path) {
           SetParam(&c, p, v);
           kept.emplace_back(p, v);
         }
-      if (b == "deterministic") c.fovea.selection.deterministic = true;
-      else c.method = "static_sgbm";
+      if (b == "deterministic")
+        c.fovea.selection.deterministic = true;
+      else
+        c.method = "static_sgbm";
       add(c, kept);
     }
   return sweep;
@@ -232,7 +245,8 @@ Sweep ParseSweep(const std::string& text, const std::string& path) {
 nlohmann::json GridJson(const Sweep& sweep) {
   nlohmann::json j;
   j["axes"] = nlohmann::json::array();
-  for (const SweepAxis& a : sweep.axes) j["axes"].push_back({{"path", a.path}, {"values", a.values}});
+  for (const SweepAxis& a : sweep.axes)
+    j["axes"].push_back({{"path", a.path}, {"values", a.values}});
   j["baselines"] = sweep.baselines;
   j["runs"] = nlohmann::json::array();
   for (const SweepRun& r : sweep.runs) {
@@ -255,7 +269,8 @@ bool IsWallClockColumn(const std::string& column) {
 
 namespace {
 
-void Flatten(const nlohmann::json& j, const std::string& prefix, std::map<std::string, std::string>* out) {
+void Flatten(const nlohmann::json& j, const std::string& prefix,
+             std::map<std::string, std::string>* out) {
   if (j.is_object()) {
     for (auto it = j.begin(); it != j.end(); ++it)
       Flatten(it.value(), prefix.empty() ? it.key() : prefix + "." + it.key(), out);
@@ -285,9 +300,11 @@ nlohmann::json ReadJson(const std::string& path) {
   }
 }
 
-std::string ResultsCsv(const std::string& dir, const nlohmann::json& grid, std::vector<std::string>* missing) {
+std::string ResultsCsv(const std::string& dir, const nlohmann::json& grid,
+                       std::vector<std::string>* missing) {
   std::vector<std::string> param_columns;
-  for (const auto& p : grid.at("runs").at(0).at("config")) param_columns.push_back(p.at(0).get<std::string>());
+  for (const auto& p : grid.at("runs").at(0).at("config"))
+    param_columns.push_back(p.at(0).get<std::string>());
   std::vector<std::map<std::string, std::string>> rows;
   std::set<std::string> figure_columns;
   for (const auto& run : grid.at("runs")) {
@@ -299,10 +316,12 @@ std::string ResultsCsv(const std::string& dir, const nlohmann::json& grid, std::
     }
     std::map<std::string, std::string> figures;
     Flatten(ReadJson(summary_path), "", &figures);
-    for (const char* own : {"scene", "seed", "method", "matcher"}) figures.erase(own);  // parameters already
+    for (const char* own : {"scene", "seed", "method", "matcher"})
+      figures.erase(own);  // parameters already
     for (const auto& [k, v] : figures) figure_columns.insert(k);
     std::map<std::string, std::string> row = figures;
-    for (const auto& p : run.at("config")) row["param:" + p.at(0).get<std::string>()] = p.at(1).get<std::string>();
+    for (const auto& p : run.at("config"))
+      row["param:" + p.at(0).get<std::string>()] = p.at(1).get<std::string>();
     row["run_id"] = id;
     row["variant"] = run.at("variant").get<std::string>();
     rows.push_back(std::move(row));

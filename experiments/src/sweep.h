@@ -30,7 +30,7 @@ struct Sweep {
   std::string file;
   std::vector<SweepAxis> axes;
   std::vector<std::string> baselines;
-  int jobs = 0;  ///< 0 = every local core
+  int jobs = 0;                ///< 0 = every local core
   std::vector<SweepRun> runs;  ///< grid order (last axis fastest), then baselines; no two alike
 };
 
@@ -58,7 +58,8 @@ bool IsWallClockColumn(const std::string& column);
 /// The tidy CSV of a sweep folder: a row per finished run in grid order
 /// (run_id, variant, every parameter, every figure of its summary.json).
 /// Runs without a result are listed in `*missing`.
-std::string ResultsCsv(const std::string& dir, const nlohmann::json& grid, std::vector<std::string>* missing);
+std::string ResultsCsv(const std::string& dir, const nlohmann::json& grid,
+                       std::vector<std::string>* missing);
 
 /// Parses "I/N" (1 <= I <= N); throws UsageError.
 std::pair<int, int> ParseShard(const std::string& text);

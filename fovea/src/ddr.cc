@@ -26,19 +26,23 @@ double FovealShare(const PatchMap& map, const rig::CameraView& view) {
 void CriteriaOptions::Check() const {
   auto bad = [](const std::string& what) { throw std::invalid_argument(what); };
   if (!(gradient_blur_px > 0)) bad("criteria.gradient_blur_px must be > 0");
-  if (!(suppressed_weight >= 0 && suppressed_weight <= 1)) bad("criteria.suppressed_weight must be in [0, 1]");
+  if (!(suppressed_weight >= 0 && suppressed_weight <= 1))
+    bad("criteria.suppressed_weight must be in [0, 1]");
   if (!(suppression_radius_m >= 0)) bad("criteria.suppression_radius_m must be >= 0");
-  if (!(peripheral_weight >= 0 && peripheral_weight <= 1)) bad("criteria.peripheral_weight must be in [0, 1]");
+  if (!(peripheral_weight >= 0 && peripheral_weight <= 1))
+    bad("criteria.peripheral_weight must be in [0, 1]");
   if (!(revisit_radius_m >= 0)) bad("criteria.revisit_radius_m must be >= 0");
   if (!(proximity_2d_scale_px > 0)) bad("criteria.proximity_2d_scale_px must be > 0");
-  if (!(proximity_3d_low >= 0 && proximity_3d_low <= 1)) bad("criteria.proximity_3d_low must be in [0, 1]");
+  if (!(proximity_3d_low >= 0 && proximity_3d_low <= 1))
+    bad("criteria.proximity_3d_low must be in [0, 1]");
 }
 
 std::vector<std::shared_ptr<const FixationCriterion>> CriteriaOptions::Make() const {
   std::vector<std::shared_ptr<const FixationCriterion>> c;
   if (gradient) c.push_back(std::make_shared<GradientAttraction>(gradient_blur_px));
-  if (suppression) c.push_back(std::make_shared<LocalSuppression>(suppressed_weight, suppression_radius_m, peripheral_weight,
-                                                                    revisit_radius_m));
+  if (suppression)
+    c.push_back(std::make_shared<LocalSuppression>(suppressed_weight, suppression_radius_m,
+                                                   peripheral_weight, revisit_radius_m));
   if (proximity_2d) c.push_back(std::make_shared<Proximity2D>(proximity_2d_scale_px));
   if (proximity_3d) c.push_back(std::make_shared<Proximity3D>(proximity_3d_low));
   return c;
@@ -100,7 +104,8 @@ FoveaRun RunFovea(rig::Rig& rig, const StereoMatcher& matcher, const FoveaOption
       rec.selection.ok = true;
       rec.selection.point_W = run.idr.first_fixation_W;
     } else {
-      SelectionContext context = SelectionContext::Make(view.gray, view, run.map, options.fixate_holes);
+      SelectionContext context =
+          SelectionContext::Make(view.gray, view, run.map, options.fixate_holes);
       context.has_fixation = has_fixation;
       context.fixation_depth_m = current.fixation_depth_m;
       context.z_t_near_m = current.z_t_near_m;
@@ -121,9 +126,11 @@ FoveaRun RunFovea(rig::Rig& rig, const StereoMatcher& matcher, const FoveaOption
     // A hole's depth is the nearest mapped depth, a guess: the servo searches
     // every depth from the nearest the scene allows to infinity.
     const std::optional<DepthRange> guessed =
-        rec.selection.in_hole ? std::optional<DepthRange>(DepthRange{options.idr.z_min_m, kFarDepthM}) : std::nullopt;
-    const FixationResult r =
-        Fixate(rig, run.map, rec.target_W, matcher, fixation_options, run.fixations_done + 1, guessed);
+        rec.selection.in_hole
+            ? std::optional<DepthRange>(DepthRange{options.idr.z_min_m, kFarDepthM})
+            : std::nullopt;
+    const FixationResult r = Fixate(rig, run.map, rec.target_W, matcher, fixation_options,
+                                    run.fixations_done + 1, guessed);
     rec.time.verge_s = r.verge_time_s;
     rec.time.servo_s = r.servo_wall_s;
     rec.motion_time_s = r.motion_time_s;
@@ -162,7 +169,8 @@ FoveaRun RunFovea(rig::Rig& rig, const StereoMatcher& matcher, const FoveaOption
     fixated.push_back(rec.fixation_W);
     // The point aimed at stays unmapped where the servo settled elsewhere (a
     // hole's guessed depth, a false match): suppress it as well.
-    if ((rec.target_W - rec.fixation_W).norm() > options.criteria.revisit_radius_m) fixated.push_back(rec.target_W);
+    if ((rec.target_W - rec.fixation_W).norm() > options.criteria.revisit_radius_m)
+      fixated.push_back(rec.target_W);
     current = rec.tessellation;
     run.compute_time_s += rec.time.ComputeS();
     run.records.push_back(rec);
@@ -173,7 +181,8 @@ FoveaRun RunFovea(rig::Rig& rig, const StereoMatcher& matcher, const FoveaOption
     if (k > 0 && static_cast<int>(share_history.size()) > k &&
         share_history.back() - share_history[share_history.size() - 1 - k] < options.stall_growth) {
       run.stop_reason = "coverage stopped growing (foveal share grew by less than " +
-                        std::to_string(options.stall_growth) + " over " + std::to_string(k) + " fixations)";
+                        std::to_string(options.stall_growth) + " over " + std::to_string(k) +
+                        " fixations)";
       break;
     }
   }

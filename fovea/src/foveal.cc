@@ -14,8 +14,10 @@ namespace fovea {
 
 void FovealOptions::Check() const {
   tessellation.Check();
-  if (fovea_patch_px < 3 || periphery_patch_px < 3) throw std::invalid_argument("foveal: patch sizes must be >= 3");
-  if (!(map_margin_px > 0) || !(coarse_margin_px > 0)) throw std::invalid_argument("foveal: margins must be positive");
+  if (fovea_patch_px < 3 || periphery_patch_px < 3)
+    throw std::invalid_argument("foveal: patch sizes must be >= 3");
+  if (!(map_margin_px > 0) || !(coarse_margin_px > 0))
+    throw std::invalid_argument("foveal: margins must be positive");
   if (!(silent_near_m >= 0)) throw std::invalid_argument("foveal: silent_near_m must be >= 0");
 }
 
@@ -58,7 +60,8 @@ FovealResult FovealStereo(const rig::StereoFrame& frame, const Eigen::Vector3d& 
       cv::resize(right.gray, r, cv::Size(), 1 / s, 1 / s, cv::INTER_AREA);
     }
     const cv::Rect& rect = t.rects[level];
-    cv::Mat lo(l.size(), CV_32F, cv::Scalar(1)), hi(l.size(), CV_32F, cv::Scalar(0));  // lo > hi: skip
+    cv::Mat lo(l.size(), CV_32F, cv::Scalar(1)),
+        hi(l.size(), CV_32F, cv::Scalar(0));  // lo > hi: skip
     // Where the map is silent: the range from silent_near_m to infinity.
     cv::Mat wide_lo(l.size(), CV_32F, cv::Scalar(1)), wide_hi(l.size(), CV_32F, cv::Scalar(0));
     const cv::Mat* coarse = level + 1 < levels ? &result.disparity_px[level + 1] : nullptr;
@@ -69,7 +72,8 @@ FovealResult FovealStereo(const rig::StereoFrame& frame, const Eigen::Vector3d& 
         const int vi = std::clamp(static_cast<int>(std::lround(v)), 0, k.height_px - 1);
         if (!rect.contains({ui, vi}) || t.mask.at<uchar>(vi, ui) == 0) continue;
         double dlo, dhi;
-        const float cd = coarse ? coarse->at<float>(std::min(coarse->rows - 1, y / 2), std::min(coarse->cols - 1, x / 2))
+        const float cd = coarse ? coarse->at<float>(std::min(coarse->rows - 1, y / 2),
+                                                    std::min(coarse->cols - 1, x / 2))
                                 : std::numeric_limits<float>::quiet_NaN();
         const float z = map_depth.at<float>(vi, ui);
         if (std::isfinite(cd)) {
@@ -87,7 +91,8 @@ FovealResult FovealStereo(const rig::StereoFrame& frame, const Eigen::Vector3d& 
           dlo = std::min(a, b) - 1;
           dhi = std::max(a, b) + 1;
           if (options.silent_near_m > 0) {
-            const double n = DisparityAtDepth(left, right, right_T_left, u, v, options.silent_near_m) / s;
+            const double n =
+                DisparityAtDepth(left, right, right_T_left, u, v, options.silent_near_m) / s;
             const double f = DisparityAtDepth(left, right, right_T_left, u, v, kFarDepthM) / s;
             if (std::isfinite(n) && std::isfinite(f)) {
               wide_lo.at<float>(y, x) = static_cast<float>(std::min({dlo, n, f}));
@@ -116,7 +121,8 @@ FovealResult FovealStereo(const rig::StereoFrame& frame, const Eigen::Vector3d& 
         for (int x = 0; x < l.cols; ++x) {
           float& d = dm.disparity_px.at<float>(y, x);
           const float w = wide.disparity_px.at<float>(y, x);
-          if (!std::isfinite(d) || !std::isfinite(w) || wide.confidence.at<float>(y, x) < options.silent_confidence)
+          if (!std::isfinite(d) || !std::isfinite(w) ||
+              wide.confidence.at<float>(y, x) < options.silent_confidence)
             continue;
           if (w < lo.at<float>(y, x) - 1 || w > hi.at<float>(y, x) + 1) {
             d = std::numeric_limits<float>::quiet_NaN();
@@ -140,8 +146,8 @@ FovealResult FovealStereo(const rig::StereoFrame& frame, const Eigen::Vector3d& 
     // than 4 x 4 of the level's pixels; their fit tolerance shrinks with the
     // level so that it stays near a full-resolution pixel and a plane cannot
     // bridge a depth step.
-    const int size = level == 0 ? options.fovea_patch_px
-                                : std::max(4, options.periphery_patch_px >> level);
+    const int size =
+        level == 0 ? options.fovea_patch_px : std::max(4, options.periphery_patch_px >> level);
     PlaneFitOptions fit_options = options.plane_fit;
     if (level > 0) {
       fit_options.fit_tolerance_px = std::max(0.25, options.plane_fit.fit_tolerance_px / s);
@@ -176,8 +182,9 @@ FovealResult FovealStereo(const rig::StereoFrame& frame, const Eigen::Vector3d& 
         for (int c = 0; c < 4 && ok; ++c) {
           const double d = (*fit)(xs[c], ys[c]) * s;
           const double u = (xs[c] + 0.5) * s - 0.5, v = (ys[c] + 0.5) * s - 0.5;
-          const auto tri = TriangulateMidpoint(PixelRay(left.world_T_camera, k, {u, v}),
-                                               PixelRay(right.world_T_camera, right.intrinsics, {u - d, v}));
+          const auto tri =
+              TriangulateMidpoint(PixelRay(left.world_T_camera, k, {u, v}),
+                                  PixelRay(right.world_T_camera, right.intrinsics, {u - d, v}));
           ok = tri.has_value();
           if (ok) p.corners_W[c] = tri->p_W;
         }
@@ -197,14 +204,15 @@ FixationResult Fixate(rig::Rig& rig, const PatchMap& map, const Eigen::Vector3d&
   FixationResult r;
   const auto t0 = Clock::now();
   if (options.choose_placement) {
-    const PlacementChoice choice = ChoosePlacement(PlacementRig::Of(rig, options.left_pair), map, p_W,
-                                                   options.baseline_m, options.vergence, guessed_depths);
+    const PlacementChoice choice =
+        ChoosePlacement(PlacementRig::Of(rig, options.left_pair), map, p_W, options.baseline_m,
+                        options.vergence, guessed_depths);
     r.placement = choice.placement;
     r.vergence = choice.vergence;
   } else {
     r.vergence = Verge(rig.Geometry(), rig.Limits(), rig.Intrinsics(rig::Side::kLeft),
-                       rig.Intrinsics(rig::Side::kRight), rig::StageState::Parallel(options.baseline_m), p_W,
-                       options.vergence);
+                       rig.Intrinsics(rig::Side::kRight),
+                       rig::StageState::Parallel(options.baseline_m), p_W, options.vergence);
   }
   if (!r.vergence.ok) {
     r.why = r.vergence.why;
@@ -226,19 +234,23 @@ FixationResult Fixate(rig::Rig& rig, const PatchMap& map, const Eigen::Vector3d&
     return r;
   };
   if (!r.servo.mutual)
-    return refuse("servoing's match is not mutual: the right camera's centre matches elsewhere in the left image");
+    return refuse(
+        "servoing's match is not mutual: the right camera's centre matches elsewhere in the left "
+        "image");
   if (guessed_depths && !r.servo.converged)
     return refuse("servoing found no unique match for a point of guessed depth");
   const rig::StereoFrame& frame = r.servo.frame;
   // Where the two optical axes (the principal points' rays) meet.
   const auto& kl = frame.left.intrinsics;
   const auto& kr = frame.right.intrinsics;
-  const auto meet = TriangulateMidpoint(PixelRay(frame.left.world_T_camera, kl, {kl.cx_px, kl.cy_px}),
-                                        PixelRay(frame.right.world_T_camera, kr, {kr.cx_px, kr.cy_px}));
+  const auto meet =
+      TriangulateMidpoint(PixelRay(frame.left.world_T_camera, kl, {kl.cx_px, kl.cy_px}),
+                          PixelRay(frame.right.world_T_camera, kr, {kr.cx_px, kr.cy_px}));
   r.fixation_W = meet ? meet->p_W : p_W;
   const double depth = (frame.left.world_T_camera.inverse() * r.fixation_W).z();
   if (depth < options.min_depth_m)
-    return refuse("servoing settled at " + std::to_string(depth) + " m, nearer than idr.z_min_m: a false match");
+    return refuse("servoing settled at " + std::to_string(depth) +
+                  " m, nearer than idr.z_min_m: a false match");
   r.foveal = FovealStereo(frame, r.fixation_W, map, matcher, options.foveal, fixation);
   r.compute_time_s = verge_s + r.foveal.compute_time_s;
   r.ok = true;

@@ -16,7 +16,8 @@ double AngleDiff(double a, double b) {
 }
 
 bool Compatible(const ZeroCrossing& a, const ZeroCrossing& b, const ZcMatchOptions& o) {
-  return a.polarity == b.polarity && AngleDiff(a.orientation_rad, b.orientation_rad) <= o.orientation_tolerance_rad;
+  return a.polarity == b.polarity &&
+         AngleDiff(a.orientation_rad, b.orientation_rad) <= o.orientation_tolerance_rad;
 }
 
 // Unique compatible crossing of `other` on row y with position in
@@ -25,8 +26,9 @@ bool Compatible(const ZeroCrossing& a, const ZeroCrossing& b, const ZcMatchOptio
 int FindUnique(const ZeroCrossing& zc, const ZeroCrossingImage& other, double x_lo, double x_hi,
                const ZcMatchOptions& o, bool smallest_disparity_is_high_x) {
   const int b = other.row_begin[zc.y_px], e = other.row_begin[zc.y_px + 1];
-  const auto first = std::lower_bound(other.crossings.begin() + b, other.crossings.begin() + e, x_lo,
-                                      [](const ZeroCrossing& c, double x) { return c.x_px < x; });
+  const auto first =
+      std::lower_bound(other.crossings.begin() + b, other.crossings.begin() + e, x_lo,
+                       [](const ZeroCrossing& c, double x) { return c.x_px < x; });
   int found = -1, count = 0, nearest = -1;
   for (auto it = first; it != other.crossings.begin() + e && it->x_px <= x_hi; ++it) {
     if (!Compatible(zc, *it, o)) continue;
@@ -60,7 +62,8 @@ bool DisparityWindows::Window(double x_px, int y_px, double* lo, double* hi) con
     return true;
   }
   bool any = false;
-  for (int y = std::max(0, y_px - row_reach); y <= std::min<int>(rows.size() - 1, y_px + row_reach); ++y) {
+  for (int y = std::max(0, y_px - row_reach); y <= std::min<int>(rows.size() - 1, y_px + row_reach);
+       ++y) {
     const auto& row = rows[y];
     auto it = std::lower_bound(row.begin(), row.end(), static_cast<float>(x_px - reach_px),
                                [](const Anchor& a, float x) { return a.x_px < x; });
@@ -78,7 +81,8 @@ bool DisparityWindows::Window(double x_px, int y_px, double* lo, double* hi) con
   return any;
 }
 
-std::vector<ZcMatch> MatchZeroCrossings(const ZeroCrossingImage& left, const ZeroCrossingImage& right,
+std::vector<ZcMatch> MatchZeroCrossings(const ZeroCrossingImage& left,
+                                        const ZeroCrossingImage& right,
                                         const DisparityWindows& left_windows,
                                         const DisparityWindows& right_windows,
                                         const ZcMatchOptions& options, ZcMatchStats* stats) {
@@ -133,8 +137,10 @@ namespace {
 // Samples bucketed in square cells, for neighbourhood queries.
 class SampleGrid {
  public:
-  SampleGrid(const std::vector<DisparitySample>& samples, double cell) : samples_(samples), cell_(std::max(1.0, cell)) {
-    for (size_t i = 0; i < samples.size(); ++i) grid_[Key(samples[i].x_px, samples[i].y_px)].push_back(static_cast<int>(i));
+  SampleGrid(const std::vector<DisparitySample>& samples, double cell)
+      : samples_(samples), cell_(std::max(1.0, cell)) {
+    for (size_t i = 0; i < samples.size(); ++i)
+      grid_[Key(samples[i].x_px, samples[i].y_px)].push_back(static_cast<int>(i));
   }
   // Indices of samples within `radius` of sample i (not i itself).
   template <typename F>
@@ -156,8 +162,10 @@ class SampleGrid {
  private:
   long long Key(double x, double y) const {
     // Cell indices offset to be non-negative, packed into 64 bits.
-    const auto ix = static_cast<unsigned long long>(static_cast<long long>(std::floor(x / cell_)) + (1LL << 30));
-    const auto iy = static_cast<unsigned long long>(static_cast<long long>(std::floor(y / cell_)) + (1LL << 30));
+    const auto ix = static_cast<unsigned long long>(static_cast<long long>(std::floor(x / cell_)) +
+                                                    (1LL << 30));
+    const auto iy = static_cast<unsigned long long>(static_cast<long long>(std::floor(y / cell_)) +
+                                                    (1LL << 30));
     return static_cast<long long>((iy << 32) | (ix & 0xffffffffULL));
   }
   const std::vector<DisparitySample>& samples_;
@@ -188,9 +196,11 @@ std::vector<char> NearDiscontinuity(const std::vector<DisparitySample>& samples,
   // Along each row, consecutive samples (whatever their distance) that jump
   // bracket a discontinuity.
   std::unordered_map<int, std::vector<int>> rows;
-  for (size_t i = 0; i < samples.size(); ++i) rows[static_cast<int>(samples[i].y_px)].push_back(static_cast<int>(i));
+  for (size_t i = 0; i < samples.size(); ++i)
+    rows[static_cast<int>(samples[i].y_px)].push_back(static_cast<int>(i));
   for (auto& [y, idx] : rows) {
-    std::sort(idx.begin(), idx.end(), [&](int a, int b) { return samples[a].x_px < samples[b].x_px; });
+    std::sort(idx.begin(), idx.end(),
+              [&](int a, int b) { return samples[a].x_px < samples[b].x_px; });
     for (size_t k = 1; k < idx.size(); ++k)
       if (std::abs(samples[idx[k]].disparity_px - samples[idx[k - 1]].disparity_px) > jump_px)
         flags[idx[k]] = flags[idx[k - 1]] = 1;
@@ -216,7 +226,8 @@ void IdrOptions::Check() const {
   if (!(unique_share > 0 && unique_share < 1)) fail("unique_share must be in (0, 1)");
   if (!(z_min_m > 0)) fail("z_min_m must be positive");
   if (!(max_slant_deg >= 0 && max_slant_deg < 89)) fail("max_slant_deg must be in [0, 89)");
-  if (!(min_expansion > 1 && max_expansion >= min_expansion)) fail("need 1 < min_expansion <= max_expansion");
+  if (!(min_expansion > 1 && max_expansion >= min_expansion))
+    fail("need 1 < min_expansion <= max_expansion");
   if (!(vergent_search_px > 0)) fail("vergent_search_px must be positive");
   if (!(vergent_baseline_m > 0)) fail("vergent_baseline_m must be positive");
   if (max_stages < 1 || max_stages > 20) fail("max_stages must be 1 to 20");
@@ -227,9 +238,8 @@ void IdrOptions::Check() const {
 }
 
 PatchMap PatchesFromDisparities(const std::vector<DisparitySample>& samples,
-                                const rig::CameraView& left, double baseline_m,
-                                int patch_size_px, const PlaneFitOptions& options,
-                                PatchLevel level) {
+                                const rig::CameraView& left, double baseline_m, int patch_size_px,
+                                const PlaneFitOptions& options, PatchLevel level) {
   PatchMap map;
   const rig::CameraIntrinsics& k = left.intrinsics;
   // Bucket samples by block so each fit sees only its own.
@@ -237,14 +247,16 @@ PatchMap PatchesFromDisparities(const std::vector<DisparitySample>& samples,
   const int bh = (k.height_px + patch_size_px - 1) / patch_size_px;
   std::vector<std::vector<DisparitySample>> blocks(bw * bh);
   for (const auto& s : samples) {
-    const int bx = static_cast<int>(s.x_px) / patch_size_px, by = static_cast<int>(s.y_px) / patch_size_px;
+    const int bx = static_cast<int>(s.x_px) / patch_size_px,
+              by = static_cast<int>(s.y_px) / patch_size_px;
     if (bx >= 0 && bx < bw && by >= 0 && by < bh) blocks[by * bw + bx].push_back(s);
   }
   for (int by = 0; by < bh; ++by) {
     for (int bx = 0; bx < bw; ++bx) {
       const double x0 = bx * patch_size_px, y0 = by * patch_size_px;
       Eigen::Vector4d box;
-      const auto fit = FitDisparityPlane(blocks[by * bw + bx], x0, y0, patch_size_px, options, &box);
+      const auto fit =
+          FitDisparityPlane(blocks[by * bw + bx], x0, y0, patch_size_px, options, &box);
       if (!fit) continue;
       // The block, cut back to half a pixel beyond its inliers: inside
       // texture the inliers span the block (crossings on every row); at a
@@ -305,11 +317,13 @@ IdrResult RunIdr(rig::Rig& rig, const IdrOptions& options) {
   const double f = frame.left.intrinsics.fx_px;
   auto t0 = Clock::now();
   ZeroCrossingImage zc_left = ExtractZeroCrossings(frame.left.gray, options.zero_crossings);
-  const double d_max0 = UnambiguousDisparityLimit(SamePolarityPeriods(zc_left), options.unique_share);
+  const double d_max0 =
+      UnambiguousDisparityLimit(SamePolarityPeriods(zc_left), options.unique_share);
   double baseline = options.fixed_initial_baseline_m > 0 ? options.fixed_initial_baseline_m
                                                          : d_max0 * options.z_min_m / f;
   baseline = std::clamp(baseline, min_baseline, max_baseline);
-  double search_limit = options.fixed_initial_baseline_m > 0 ? f * baseline / options.z_min_m : d_max0;
+  double search_limit =
+      options.fixed_initial_baseline_m > 0 ? f * baseline / options.z_min_m : d_max0;
   result.compute_time_s += Since(t0);
 
   DisparityWindows left_windows, right_windows;
@@ -322,11 +336,13 @@ IdrResult RunIdr(rig::Rig& rig, const IdrOptions& options) {
     frame = move_and_capture(baseline, &stage);
     t0 = Clock::now();
     // The actual baseline, from the camera poses (quantized and settled).
-    const double b = (frame.right.world_T_camera.translation() - frame.left.world_T_camera.translation()).norm();
+    const double b =
+        (frame.right.world_T_camera.translation() - frame.left.world_T_camera.translation()).norm();
     stage.baseline_m = b;
     stage.search_limit_px = left_windows.global ? left_windows.global_hi_px : 0;
     zc_left = ExtractZeroCrossings(frame.left.gray, options.zero_crossings);
-    const ZeroCrossingImage zc_right = ExtractZeroCrossings(frame.right.gray, options.zero_crossings);
+    const ZeroCrossingImage zc_right =
+        ExtractZeroCrossings(frame.right.gray, options.zero_crossings);
     const auto matches = MatchZeroCrossings(zc_left, zc_right, left_windows, right_windows,
                                             options.matching, &stage.stats);
     std::vector<DisparitySample> samples;
@@ -337,7 +353,8 @@ IdrResult RunIdr(rig::Rig& rig, const IdrOptions& options) {
     for (size_t i = 0; i < zc_left.crossings.size(); ++i) {
       const ZeroCrossing& z = zc_left.crossings[i];
       double lo, hi;
-      if (!matched[i] && left_windows.Window(z.x_px, z.y_px, &lo, &hi)) unmatched.emplace_back(z.x_px, z.y_px);
+      if (!matched[i] && left_windows.Window(z.x_px, z.y_px, &lo, &hi))
+        unmatched.emplace_back(z.x_px, z.y_px);
     }
     std::vector<double> disparities, separations;
     const std::vector<float> periods = SamePolarityPeriods(zc_left);
@@ -356,11 +373,13 @@ IdrResult RunIdr(rig::Rig& rig, const IdrOptions& options) {
     result.final_unmatched = unmatched;
     // Drop isolated wrong matches, then the matches at depth discontinuities.
     const double radius = 2 * options.zero_crossings.sigma_px;
-    const std::vector<char> outlier = IsolatedOutliers(samples, radius, options.discontinuity_jump_px);
+    const std::vector<char> outlier =
+        IsolatedOutliers(samples, radius, options.discontinuity_jump_px);
     std::vector<DisparitySample> clean;
     for (size_t i = 0; i < samples.size(); ++i)
       if (!outlier[i]) clean.push_back(samples[i]);
-    const std::vector<char> at_edge = NearDiscontinuity(clean, radius, options.discontinuity_jump_px);
+    const std::vector<char> at_edge =
+        NearDiscontinuity(clean, radius, options.discontinuity_jump_px);
     std::vector<DisparitySample> smooth;
     for (size_t i = 0; i < clean.size(); ++i)
       if (!at_edge[i]) smooth.push_back(clean[i]);
@@ -402,7 +421,8 @@ IdrResult RunIdr(rig::Rig& rig, const IdrOptions& options) {
                                            options.max_slant_deg * M_PI / 180));
       expansion = std::min(expansion, max_baseline / b);
       if (expansion < options.min_expansion) {
-        result.stop_reason = b >= max_baseline - 1e-9 ? "widest baseline reached" : "expansion factor too small";
+        result.stop_reason =
+            b >= max_baseline - 1e-9 ? "widest baseline reached" : "expansion factor too small";
         expansion = 1;
       }
     }
@@ -421,11 +441,13 @@ IdrResult RunIdr(rig::Rig& rig, const IdrOptions& options) {
         const float hi = static_cast<float>(expansion * (m.disparity_px + 0.5));
         const int y = static_cast<int>(m.y_px);
         left_windows.rows[y].push_back({static_cast<float>(m.x_px), lo, hi});
-        right_windows.rows[y].push_back({static_cast<float>(m.x_px - expansion * m.disparity_px), lo, hi});
+        right_windows.rows[y].push_back(
+            {static_cast<float>(m.x_px - expansion * m.disparity_px), lo, hi});
       }
       for (auto* w : {&left_windows, &right_windows})
         for (auto& row : w->rows)
-          std::sort(row.begin(), row.end(), [](const auto& a, const auto& b) { return a.x_px < b.x_px; });
+          std::sort(row.begin(), row.end(),
+                    [](const auto& a, const auto& b) { return a.x_px < b.x_px; });
     }
     stage.compute_time_s = Since(t0);
     result.compute_time_s += stage.compute_time_s;

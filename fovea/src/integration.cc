@@ -7,7 +7,8 @@ namespace fovea {
 
 void IntegrationOptions::Check() const {
   if (!(overlap_share > 0 && overlap_share <= 1))
-    throw std::invalid_argument("integration.overlap_share must be in (0, 1], got " + std::to_string(overlap_share));
+    throw std::invalid_argument("integration.overlap_share must be in (0, 1], got " +
+                                std::to_string(overlap_share));
 }
 
 IntegrationStats Integrate(PatchMap* map, const PatchMap& fresh, const rig::CameraView& view,
@@ -50,7 +51,8 @@ IntegrationStats Integrate(PatchMap* map, const PatchMap& fresh, const rig::Came
     for (int x = 0; x < old_ids.cols; ++x) {
       if (orow[x] < 0) continue;
       ++visible[orow[x]];
-      if (nr[x] >= 0 && keep[nr[x]] && level(fresh[nr[x]]) >= level((*map)[orow[x]])) ++covered[orow[x]];
+      if (nr[x] >= 0 && keep[nr[x]] && level(fresh[nr[x]]) >= level((*map)[orow[x]]))
+        ++covered[orow[x]];
     }
   }
   std::vector<char> drop(n_old, 0);

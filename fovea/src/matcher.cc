@@ -9,7 +9,8 @@
 namespace fovea {
 
 void Nl1Options::Check() const {
-  if (window_half_px < 1 || window_half_px > 20) throw std::invalid_argument("nl1: window_half_px must be 1 to 20");
+  if (window_half_px < 1 || window_half_px > 20)
+    throw std::invalid_argument("nl1: window_half_px must be 1 to 20");
   if (!(min_texture_dn >= 0)) throw std::invalid_argument("nl1: min_texture_dn must be >= 0");
   if (!(lr_tolerance_px > 0)) throw std::invalid_argument("nl1: lr_tolerance_px must be positive");
 }
@@ -76,7 +77,8 @@ DisparityMap Nl1Matcher::Match(const cv::Mat& left, const cv::Mat& right, const 
   CV_Assert(left.type() == CV_8UC1 && right.type() == CV_8UC1 && left.size() == right.size());
   const int h = options_.window_half_px;
   DisparityMap out;
-  out.disparity_px = cv::Mat(left.size(), CV_32F, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
+  out.disparity_px =
+      cv::Mat(left.size(), CV_32F, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
   out.confidence = cv::Mat(left.size(), CV_32F, cv::Scalar(0));
   cv::Mat ml, mr, texture;
   cv::boxFilter(left, ml, CV_32F, cv::Size(2 * h + 1, 2 * h + 1));
@@ -96,7 +98,8 @@ DisparityMap Nl1Matcher::Match(const cv::Mat& left, const cv::Mat& right, const 
         ++out.rejected_texture;
         continue;
       }
-      const int dlo = static_cast<int>(std::floor(lo)) - 1, dhi = static_cast<int>(std::ceil(hi)) + 1;
+      const int dlo = static_cast<int>(std::floor(lo)) - 1,
+                dhi = static_cast<int>(std::ceil(hi)) + 1;
       const Best b = Search(left, right, ml, mr, x, y, dlo, dhi, h, false, costs);
       if (!std::isfinite(b.cost) || b.edge) {
         ++out.rejected_edge;
@@ -105,12 +108,14 @@ DisparityMap Nl1Matcher::Match(const cv::Mat& left, const cv::Mat& right, const 
       // Left-right check: from the matched right pixel, search back.
       const int xr = x - b.d;
       const Best back = Search(right, left, mr, ml, xr, y, dlo, dhi, h, true, costs);
-      if (!std::isfinite(back.cost) || std::abs((back.d + back.sub) - (b.d + b.sub)) > options_.lr_tolerance_px) {
+      if (!std::isfinite(back.cost) ||
+          std::abs((back.d + back.sub) - (b.d + b.sub)) > options_.lr_tolerance_px) {
         ++out.rejected_lr;
         continue;
       }
       out.disparity_px.at<float>(y, x) = static_cast<float>(b.d + b.sub);
-      const float margin = std::isfinite(b.second) ? (b.second - b.cost) / (b.second + 1e-3f) : 1.0f;
+      const float margin =
+          std::isfinite(b.second) ? (b.second - b.cost) / (b.second + 1e-3f) : 1.0f;
       out.confidence.at<float>(y, x) = std::clamp(margin, 0.0f, 1.0f);
       ++out.matched;
     }

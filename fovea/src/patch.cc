@@ -9,9 +9,12 @@ namespace fovea {
 
 const char* PatchLevelName(PatchLevel level) {
   switch (level) {
-    case PatchLevel::kIdr: return "idr";
-    case PatchLevel::kPeripheral: return "peripheral";
-    case PatchLevel::kFoveal: return "foveal";
+    case PatchLevel::kIdr:
+      return "idr";
+    case PatchLevel::kPeripheral:
+      return "peripheral";
+    case PatchLevel::kFoveal:
+      return "foveal";
   }
   return "?";
 }
@@ -35,7 +38,8 @@ std::optional<PlaneFit> FitDisparityPlane(const std::vector<DisparitySample>& sa
   const double cx = x0 + 0.5 * size, cy = y0 + 0.5 * size;
   std::vector<const DisparitySample*> in_block;
   for (const auto& s : samples)
-    if (s.x_px >= x0 && s.x_px < x0 + size && s.y_px >= y0 && s.y_px < y0 + size) in_block.push_back(&s);
+    if (s.x_px >= x0 && s.x_px < x0 + size && s.y_px >= y0 && s.y_px < y0 + size)
+      in_block.push_back(&s);
   const int total = static_cast<int>(in_block.size());
   if (total < std::max(3, options.min_support)) return std::nullopt;
 
@@ -58,7 +62,8 @@ std::optional<PlaneFit> FitDisparityPlane(const std::vector<DisparitySample>& sa
     fit.c = p(2) - p(0) * cx - p(1) * cy;
     std::vector<const DisparitySample*> kept;
     for (const DisparitySample* s : in_block)
-      if (std::abs(s->disparity_px - fit(s->x_px, s->y_px)) <= options.fit_tolerance_px) kept.push_back(s);
+      if (std::abs(s->disparity_px - fit(s->x_px, s->y_px)) <= options.fit_tolerance_px)
+        kept.push_back(s);
     const bool converged = kept.size() == inliers.size();
     inliers.swap(kept);
     if (static_cast<int>(inliers.size()) < std::max(3, options.min_support)) return std::nullopt;
@@ -150,7 +155,8 @@ double RayPatch(const Eigen::Vector3d& o, const Eigen::Vector3d& d, const Patch&
 }
 
 // Entry distance of the ray into the box (slab test), or +infinity if missed.
-double RayBox(const Eigen::Vector3d& o, const Eigen::Vector3d& inv_d, const Eigen::AlignedBox3d& b) {
+double RayBox(const Eigen::Vector3d& o, const Eigen::Vector3d& inv_d,
+              const Eigen::AlignedBox3d& b) {
   double t0 = 0, t1 = std::numeric_limits<double>::infinity();
   for (int a = 0; a < 3; ++a) {
     double ta = (b.min()(a) - o(a)) * inv_d(a), tb = (b.max()(a) - o(a)) * inv_d(a);
@@ -270,8 +276,8 @@ std::optional<PatchHit> PatchMap::CastRayBruteForce(const Eigen::Vector3d& origi
   return best;
 }
 
-void PatchMap::Render(const Eigen::Isometry3d& world_T_camera,
-                      const rig::CameraIntrinsics& k, cv::Mat* depth_m, cv::Mat* patch_ids) const {
+void PatchMap::Render(const Eigen::Isometry3d& world_T_camera, const rig::CameraIntrinsics& k,
+                      cv::Mat* depth_m, cv::Mat* patch_ids) const {
   cv::Mat depth(k.height_px, k.width_px, CV_32F, cv::Scalar(0));
   cv::Mat ids(k.height_px, k.width_px, CV_32S, cv::Scalar(-1));
   const Eigen::Isometry3d camera_T_world = world_T_camera.inverse();
@@ -289,19 +295,28 @@ void PatchMap::Render(const Eigen::Isometry3d& world_T_camera,
       double inv_z[3];
       for (int j = 0; j < 3; ++j) {
         const Eigen::Vector3d& q = p_C[tri[j]];
-        uv[j] = Eigen::Vector2d(k.fx_px * q.x() / q.z() + k.cx_px, k.fy_px * q.y() / q.z() + k.cy_px);
+        uv[j] =
+            Eigen::Vector2d(k.fx_px * q.x() / q.z() + k.cx_px, k.fy_px * q.y() / q.z() + k.cy_px);
         inv_z[j] = 1.0 / q.z();
       }
-      const double area = (uv[1] - uv[0]).x() * (uv[2] - uv[0]).y() - (uv[1] - uv[0]).y() * (uv[2] - uv[0]).x();
+      const double area =
+          (uv[1] - uv[0]).x() * (uv[2] - uv[0]).y() - (uv[1] - uv[0]).y() * (uv[2] - uv[0]).x();
       if (std::abs(area) < 1e-12) continue;
-      const int u0 = std::max(0, static_cast<int>(std::ceil(std::min({uv[0].x(), uv[1].x(), uv[2].x()}))));
-      const int u1 = std::min(k.width_px - 1, static_cast<int>(std::floor(std::max({uv[0].x(), uv[1].x(), uv[2].x()}))));
-      const int v0 = std::max(0, static_cast<int>(std::ceil(std::min({uv[0].y(), uv[1].y(), uv[2].y()}))));
-      const int v1 = std::min(k.height_px - 1, static_cast<int>(std::floor(std::max({uv[0].y(), uv[1].y(), uv[2].y()}))));
+      const int u0 =
+          std::max(0, static_cast<int>(std::ceil(std::min({uv[0].x(), uv[1].x(), uv[2].x()}))));
+      const int u1 =
+          std::min(k.width_px - 1,
+                   static_cast<int>(std::floor(std::max({uv[0].x(), uv[1].x(), uv[2].x()}))));
+      const int v0 =
+          std::max(0, static_cast<int>(std::ceil(std::min({uv[0].y(), uv[1].y(), uv[2].y()}))));
+      const int v1 =
+          std::min(k.height_px - 1,
+                   static_cast<int>(std::floor(std::max({uv[0].y(), uv[1].y(), uv[2].y()}))));
       for (int v = v0; v <= v1; ++v) {
         for (int u = u0; u <= u1; ++u) {
           const Eigen::Vector2d p(u, v);
-          auto edge = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
+          auto edge = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                         const Eigen::Vector2d& c) {
             return (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
           };
           const double w0 = edge(uv[1], uv[2], p) / area, w1 = edge(uv[2], uv[0], p) / area;

@@ -8,10 +8,14 @@ namespace fovea {
 
 const char* PlacementName(Placement placement) {
   switch (placement) {
-    case Placement::kSymmetric: return "symmetric";
-    case Placement::kRightInner: return "right_inner";
-    case Placement::kLeftInner: return "left_inner";
-    case Placement::kLeftPair: return "left_pair";
+    case Placement::kSymmetric:
+      return "symmetric";
+    case Placement::kRightInner:
+      return "right_inner";
+    case Placement::kLeftInner:
+      return "left_inner";
+    case Placement::kLeftPair:
+      return "left_pair";
   }
   return "?";
 }
@@ -52,9 +56,10 @@ rig::StageState PlaceCarriages(const PlacementRig& rig, double baseline_m, Place
   return s;
 }
 
-PlacementChoice ChoosePlacement(const PlacementRig& rig, const PatchMap& map, const Eigen::Vector3d& p_W,
-                                double baseline_m,
-                                const VergenceOptions& vergence, const std::optional<DepthRange>& guessed_depths) {
+PlacementChoice ChoosePlacement(const PlacementRig& rig, const PatchMap& map,
+                                const Eigen::Vector3d& p_W, double baseline_m,
+                                const VergenceOptions& vergence,
+                                const std::optional<DepthRange>& guessed_depths) {
   // A sample is hidden when the map has a patch this share nearer along the ray.
   constexpr double kNearerShare = 0.03;
   // Multiples of a guessed point's depth sampled behind it.
@@ -66,22 +71,24 @@ PlacementChoice ChoosePlacement(const PlacementRig& rig, const PatchMap& map, co
     return hit && hit->distance_m < (1 - kNearerShare) * distance;
   };
   std::optional<PlacementChoice> best, failed;
-  for (Placement placement :
-       {Placement::kRightInner, Placement::kSymmetric, Placement::kLeftInner, Placement::kLeftPair}) {
+  for (Placement placement : {Placement::kRightInner, Placement::kSymmetric, Placement::kLeftInner,
+                              Placement::kLeftPair}) {
     if (placement == Placement::kLeftPair && !rig.left_pair) continue;
     const PlacementRig pair = rig.For(placement);
     const rig::RigGeometry& geometry = pair.geometry;
     PlacementChoice c;
     c.placement = placement;
-    c.vergence = Verge(geometry, pair.limits, pair.left, pair.right, PlaceCarriages(pair, baseline_m, placement), p_W,
-                       vergence);
+    c.vergence = Verge(geometry, pair.limits, pair.left, pair.right,
+                       PlaceCarriages(pair, baseline_m, placement), p_W, vergence);
     if (!c.vergence.ok) {
       if (!failed) failed = c;
       continue;
     }
-    const Eigen::Isometry3d left_W = geometry.WorldFromCamera(rig::Side::kLeft, c.vergence.state.left);
+    const Eigen::Isometry3d left_W =
+        geometry.WorldFromCamera(rig::Side::kLeft, c.vergence.state.left);
     const Eigen::Vector3d left_c = left_W.translation();
-    const Eigen::Vector3d right_c = geometry.WorldFromCamera(rig::Side::kRight, c.vergence.state.right).translation();
+    const Eigen::Vector3d right_c =
+        geometry.WorldFromCamera(rig::Side::kRight, c.vergence.state.right).translation();
     std::vector<Eigen::Vector3d> samples{p_W};
     if (guessed_depths) {
       const Eigen::Vector3d axis = left_W.linear().col(2);
@@ -90,7 +97,8 @@ PlacementChoice ChoosePlacement(const PlacementRig& rig, const PatchMap& map, co
         if (k * depth <= guessed_depths->far_m) samples.push_back(left_c + k * depth * axis);
     }
     if (!map.empty())
-      for (const Eigen::Vector3d& q : samples) c.occluded += int(hidden(left_c, q)) + int(hidden(right_c, q));
+      for (const Eigen::Vector3d& q : samples)
+        c.occluded += int(hidden(left_c, q)) + int(hidden(right_c, q));
     if (!best || c.occluded < best->occluded) best = c;
     if (best->occluded == 0) break;
   }

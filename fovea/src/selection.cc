@@ -10,8 +10,8 @@
 
 namespace fovea {
 
-SelectionContext SelectionContext::Make(const cv::Mat& image, const rig::CameraView& view, const PatchMap& map,
-                                        bool fill_holes) {
+SelectionContext SelectionContext::Make(const cv::Mat& image, const rig::CameraView& view,
+                                        const PatchMap& map, bool fill_holes) {
   SelectionContext c;
   c.image = image;
   c.view = view;
@@ -29,14 +29,17 @@ SelectionContext SelectionContext::Make(const cv::Mat& image, const rig::CameraV
   if (n_holes == 0 || n_holes == static_cast<int>(holes.total())) return c;
   // Each hole pixel gets the label of its nearest mapped (zero) pixel.
   cv::Mat distance, labels;
-  cv::distanceTransform(holes, distance, labels, cv::DIST_L2, cv::DIST_MASK_5, cv::DIST_LABEL_PIXEL);
+  cv::distanceTransform(holes, distance, labels, cv::DIST_L2, cv::DIST_MASK_5,
+                        cv::DIST_LABEL_PIXEL);
   std::vector<float> depth_of_label(holes.total() + 1, 0.f);
   for (int y = 0; y < holes.rows; ++y)
     for (int x = 0; x < holes.cols; ++x)
-      if (!holes.at<uchar>(y, x)) depth_of_label[labels.at<int>(y, x)] = c.map_depth_m.at<float>(y, x);
+      if (!holes.at<uchar>(y, x))
+        depth_of_label[labels.at<int>(y, x)] = c.map_depth_m.at<float>(y, x);
   for (int y = 0; y < holes.rows; ++y)
     for (int x = 0; x < holes.cols; ++x)
-      if (holes.at<uchar>(y, x)) c.map_depth_m.at<float>(y, x) = depth_of_label[labels.at<int>(y, x)];
+      if (holes.at<uchar>(y, x))
+        c.map_depth_m.at<float>(y, x) = depth_of_label[labels.at<int>(y, x)];
   return c;
 }
 
@@ -66,7 +69,8 @@ cv::Mat GradientAttraction::Evaluate(const SelectionContext& c) const {
 }
 
 Eigen::Vector3d SelectionContext::MapPoint(int x, int y) const {
-  return view.world_T_camera * (map_depth_m.at<float>(y, x) * view.intrinsics.Ray({double(x), double(y)}));
+  return view.world_T_camera *
+         (map_depth_m.at<float>(y, x) * view.intrinsics.Ray({double(x), double(y)}));
 }
 
 cv::Mat LocalSuppression::Evaluate(const SelectionContext& c) const {
@@ -96,7 +100,8 @@ cv::Mat Proximity2D::Evaluate(const SelectionContext& c) const {
   cv::Mat w(c.image.size(), CV_64F);
   const double cx = c.view.intrinsics.cx_px, cy = c.view.intrinsics.cy_px;
   for (int y = 0; y < w.rows; ++y)
-    for (int x = 0; x < w.cols; ++x) w.at<double>(y, x) = std::exp(-std::hypot(x - cx, y - cy) / scale_);
+    for (int x = 0; x < w.cols; ++x)
+      w.at<double>(y, x) = std::exp(-std::hypot(x - cx, y - cy) / scale_);
   NormalizeSum(&w);
   return w;
 }
@@ -121,7 +126,8 @@ void SelectionOptions::Check() const {
   if (histogram_bins < 2 || histogram_bins > 4096)
     bad("selection.histogram_bins must be 2 to 4096, got " + std::to_string(histogram_bins));
   if (border_px < 0) bad("selection.border_px must be >= 0, got " + std::to_string(border_px));
-  if (!(refused_radius_m >= 0)) bad("selection.refused_radius_m must be >= 0, got " + std::to_string(refused_radius_m));
+  if (!(refused_radius_m >= 0))
+    bad("selection.refused_radius_m must be >= 0, got " + std::to_string(refused_radius_m));
 }
 
 std::vector<std::shared_ptr<const FixationCriterion>> FixationSelector::DefaultCriteria() {
@@ -135,7 +141,8 @@ FixationSelector::FixationSelector(std::vector<std::shared_ptr<const FixationCri
   options_.Check();
 }
 
-cv::Mat FixationSelector::Composite(const SelectionContext& c, const std::vector<Eigen::Vector3d>& refused_W,
+cv::Mat FixationSelector::Composite(const SelectionContext& c,
+                                    const std::vector<Eigen::Vector3d>& refused_W,
                                     std::vector<cv::Mat>* each) const {
   cv::Mat composite(c.image.size(), CV_64F, cv::Scalar(1.0));
   if (each) each->clear();
@@ -159,7 +166,8 @@ cv::Mat FixationSelector::Composite(const SelectionContext& c, const std::vector
       if (c.region) {
         const auto uv = ProjectWorldPoint(c.region->world_T_camera, c.region->intrinsics, p_W);
         const auto& k = c.region->intrinsics;
-        if (!uv || uv->x() < b || uv->y() < b || uv->x() > k.width_px - 1 - b || uv->y() > k.height_px - 1 - b) {
+        if (!uv || uv->x() < b || uv->y() < b || uv->x() > k.width_px - 1 - b ||
+            uv->y() > k.height_px - 1 - b) {
           v = 0;
           continue;
         }
@@ -212,8 +220,10 @@ SelectionSummary FixationSelector::Choose(const SelectionContext& c, const Patch
     const int target = bin_of(s.drawn_value);
     chosen_bin = -1;
     for (int d = 0; d < bins && chosen_bin < 0; ++d) {
-      if (target + d < bins && count[target + d] > 0) chosen_bin = target + d;
-      else if (target - d >= 0 && count[target - d] > 0) chosen_bin = target - d;
+      if (target + d < bins && count[target + d] > 0)
+        chosen_bin = target + d;
+      else if (target - d >= 0 && count[target - d] > 0)
+        chosen_bin = target - d;
     }
   }
   s.bin = chosen_bin;
@@ -248,7 +258,8 @@ SelectionSummary FixationSelector::Choose(const SelectionContext& c, const Patch
   const cv::Mat candidates = composite > 0;
   for (size_t i = 0; i < criteria_.size(); ++i) {
     const double mean = cv::mean(each[i], candidates)[0];
-    s.criteria.emplace_back(criteria_[i]->Name(), mean > 0 ? each[i].at<double>(by, bx) / mean : 0.0);
+    s.criteria.emplace_back(criteria_[i]->Name(),
+                            mean > 0 ? each[i].at<double>(by, bx) / mean : 0.0);
   }
   s.ok = true;
   return s;

@@ -9,16 +9,22 @@
 namespace fovea {
 
 void ServoOptions::Check() const {
-  if (window_half_px < 2 || window_half_px > 100) throw std::invalid_argument("servo: window_half_px must be 2 to 100");
-  if (search_px < 1 || search_px > 300) throw std::invalid_argument("servo: search_px must be 1 to 300");
-  if (refine_px < 1 || refine_px > 300) throw std::invalid_argument("servo: refine_px must be 1 to 300");
+  if (window_half_px < 2 || window_half_px > 100)
+    throw std::invalid_argument("servo: window_half_px must be 2 to 100");
+  if (search_px < 1 || search_px > 300)
+    throw std::invalid_argument("servo: search_px must be 1 to 300");
+  if (refine_px < 1 || refine_px > 300)
+    throw std::invalid_argument("servo: refine_px must be 1 to 300");
   if (!(tolerance_px > 0)) throw std::invalid_argument("servo: tolerance_px must be positive");
   if (max_steps < 1) throw std::invalid_argument("servo: max_steps must be >= 1");
-  if (!(unique_ratio > 0 && unique_ratio <= 1)) throw std::invalid_argument("servo: unique_ratio must be in (0, 1]");
-  if (!(mutual_tolerance_px >= 0)) throw std::invalid_argument("servo: mutual_tolerance_px must be >= 0");
+  if (!(unique_ratio > 0 && unique_ratio <= 1))
+    throw std::invalid_argument("servo: unique_ratio must be in (0, 1]");
+  if (!(mutual_tolerance_px >= 0))
+    throw std::invalid_argument("servo: mutual_tolerance_px must be >= 0");
 }
 
-double NormalizedL1(const cv::Mat& left, int xl, int yl, const cv::Mat& right, int xr, int yr, int half) {
+double NormalizedL1(const cv::Mat& left, int xl, int yl, const cv::Mat& right, int xr, int yr,
+                    int half) {
   const int n = (2 * half + 1) * (2 * half + 1);
   double ml = 0, mr = 0;
   for (int dy = -half; dy <= half; ++dy) {
@@ -47,18 +53,20 @@ namespace {
 // minimum at the edge of the search is no match, and with `unique_ratio` < 1
 // neither is one whose cost is not below that share of the best minimum
 // elsewhere (outside the best's window half-width).
-std::optional<double> SearchRow(const rig::CameraView& from, const rig::CameraView& to, const ServoOptions& o,
-                                int lo, int hi, double unique_ratio) {
+std::optional<double> SearchRow(const rig::CameraView& from, const rig::CameraView& to,
+                                const ServoOptions& o, int lo, int hi, double unique_ratio) {
   const cv::Mat& l = from.gray;
   const cv::Mat& r = to.gray;
   const int xl = static_cast<int>(std::lround(from.intrinsics.cx_px));
   const int yl = static_cast<int>(std::lround(from.intrinsics.cy_px));
   const int xr0 = static_cast<int>(std::lround(to.intrinsics.cx_px));
   const int h = o.window_half_px;
-  if (xl - h < 0 || yl - h < 0 || xl + h >= l.cols || yl + h >= l.rows || yl + h >= r.rows || hi <= lo)
+  if (xl - h < 0 || yl - h < 0 || xl + h >= l.cols || yl + h >= l.rows || yl + h >= r.rows ||
+      hi <= lo)
     return std::nullopt;
   // No texture in the window: nothing to servo on.
-  if (NormalizedL1(l, xl, yl, cv::Mat(l.size(), CV_8U, cv::Scalar(0)), xl, yl, h) < 2.0) return std::nullopt;
+  if (NormalizedL1(l, xl, yl, cv::Mat(l.size(), CV_8U, cv::Scalar(0)), xl, yl, h) < 2.0)
+    return std::nullopt;
   const int n = hi - lo + 1;
   std::vector<double> cost(n, 1e300);
   int best = -1;
@@ -68,11 +76,13 @@ std::optional<double> SearchRow(const rig::CameraView& from, const rig::CameraVi
     cost[i] = NormalizedL1(l, xl, yl, r, xr, yl, h);
     if (best < 0 || cost[i] < cost[best]) best = i;
   }
-  if (best <= 0 || best >= n - 1 || cost[best - 1] >= 1e300 || cost[best + 1] >= 1e300) return std::nullopt;
+  if (best <= 0 || best >= n - 1 || cost[best - 1] >= 1e300 || cost[best + 1] >= 1e300)
+    return std::nullopt;
   if (unique_ratio < 1) {
     for (int i = 1; i + 1 < n; ++i) {
       const bool local_min = cost[i] <= cost[i - 1] && cost[i] <= cost[i + 1] && cost[i] < 1e300;
-      if (local_min && std::abs(i - best) > h && cost[best] >= unique_ratio * cost[i]) return std::nullopt;
+      if (local_min && std::abs(i - best) > h && cost[best] >= unique_ratio * cost[i])
+        return std::nullopt;
     }
   }
   const double c0 = cost[best - 1], c1 = cost[best], c2 = cost[best + 1];
@@ -83,11 +93,13 @@ std::optional<double> SearchRow(const rig::CameraView& from, const rig::CameraVi
 
 }  // namespace
 
-std::optional<double> CentreDisparity(const rig::StereoFrame& frame, const ServoOptions& o, int search_px) {
+std::optional<double> CentreDisparity(const rig::StereoFrame& frame, const ServoOptions& o,
+                                      int search_px) {
   return SearchRow(frame.left, frame.right, o, -search_px, search_px, 1.0);
 }
 
-std::optional<double> MutualMismatch(const rig::StereoFrame& frame, const ServoOptions& o, double residual_px) {
+std::optional<double> MutualMismatch(const rig::StereoFrame& frame, const ServoOptions& o,
+                                     double residual_px) {
   const auto reverse = SearchRow(frame.right, frame.left, o, -o.search_px, o.search_px, 1.0);
   if (!reverse) return std::nullopt;
   // Both searches centre their windows on the principal points' rounded
@@ -96,14 +108,17 @@ std::optional<double> MutualMismatch(const rig::StereoFrame& frame, const ServoO
   // shifted by the two roundings.
   const auto& kl = frame.left.intrinsics;
   const auto& kr = frame.right.intrinsics;
-  const double expected = (std::lround(kl.cx_px) - kl.cx_px) + (std::lround(kr.cx_px) - kr.cx_px) - residual_px;
+  const double expected =
+      (std::lround(kl.cx_px) - kl.cx_px) + (std::lround(kr.cx_px) - kr.cx_px) - residual_px;
   return *reverse - expected;
 }
 
-std::optional<double> CentreDisparity(const rig::StereoFrame& frame, const ServoOptions& o, const DepthRange& depths) {
+std::optional<double> CentreDisparity(const rig::StereoFrame& frame, const ServoOptions& o,
+                                      const DepthRange& depths) {
   if (!(depths.near_m > 0) || !(depths.far_m >= depths.near_m))
     throw std::invalid_argument("servo: depth range must have 0 < near_m <= far_m");
-  const Eigen::Isometry3d right_T_left = frame.right.world_T_camera.inverse() * frame.left.world_T_camera;
+  const Eigen::Isometry3d right_T_left =
+      frame.right.world_T_camera.inverse() * frame.left.world_T_camera;
   const rig::CameraIntrinsics& kl = frame.left.intrinsics;
   const rig::CameraIntrinsics& kr = frame.right.intrinsics;
   double lo = 1e300, hi = -1e300;
@@ -133,7 +148,8 @@ ServoResult Servo(rig::Rig& rig, const rig::StageState& start, const ServoOption
   for (int step = 0;; ++step) {
     result.frame = rig.Capture();
     result.state = result.frame.state;
-    const int refine = std::max(o.refine_px, static_cast<int>(std::ceil(std::abs(result.residual_px) / 4)));
+    const int refine =
+        std::max(o.refine_px, static_cast<int>(std::ceil(std::abs(result.residual_px) / 4)));
     const auto d = step > 0       ? CentreDisparity(result.frame, o, refine)
                    : first_depths ? CentreDisparity(result.frame, o, *first_depths)
                                   : CentreDisparity(result.frame, o, o.search_px);
@@ -144,7 +160,8 @@ ServoResult Servo(rig::Rig& rig, const rig::StageState& start, const ServoOption
       result.converged = true;
       if (o.mutual_tolerance_px > 0) {
         result.mutual_mismatch_px = MutualMismatch(result.frame, o, *d);
-        result.mutual = result.mutual_mismatch_px && std::abs(*result.mutual_mismatch_px) < o.mutual_tolerance_px;
+        result.mutual = result.mutual_mismatch_px &&
+                        std::abs(*result.mutual_mismatch_px) < o.mutual_tolerance_px;
         result.converged = result.mutual;
       }
       break;

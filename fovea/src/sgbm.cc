@@ -4,9 +4,8 @@
 #include <cmath>
 #include <limits>
 #include <opencv2/calib3d.hpp>
-#include <opencv2/imgproc.hpp>
-
 #include <opencv2/core/eigen.hpp>
+#include <opencv2/imgproc.hpp>
 
 namespace fovea {
 namespace {
@@ -22,7 +21,8 @@ cv::Ptr<cv::StereoSGBM> Make(const SgbmOptions& o, int min_d, int num_d) {
 DisparityMap SgbmMatcher::Match(const cv::Mat& left, const cv::Mat& right, const cv::Mat& lo_px,
                                 const cv::Mat& hi_px) const {
   DisparityMap out;
-  out.disparity_px = cv::Mat(left.size(), CV_32F, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
+  out.disparity_px =
+      cv::Mat(left.size(), CV_32F, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
   out.confidence = cv::Mat(left.size(), CV_32F, cv::Scalar(0));
   double lo = 1e9, hi = -1e9;
   for (int y = 0; y < left.rows; ++y)
@@ -91,13 +91,15 @@ cv::Mat RectifiedSgbmDepth(const rig::CameraView& left, const rig::CameraView& r
   cv::undistortPoints(src, dst, k1, cv::noArray(), r1, p1);
   cv::Matx33d r1m(r1);
   for (size_t i = 0; i < src.size(); ++i) {
-    const int x = static_cast<int>(std::lround(dst[i].x)), y = static_cast<int>(std::lround(dst[i].y));
+    const int x = static_cast<int>(std::lround(dst[i].x)),
+              y = static_cast<int>(std::lround(dst[i].y));
     if (x < 0 || y < 0 || x >= size.width || y >= size.height) continue;
     if (d.at<float>(y, x) <= min_d) continue;
     const cv::Vec3f p = xyz.at<cv::Vec3f>(y, x);
     if (!std::isfinite(p[2]) || p[2] <= 0 || p[2] > 100) continue;
     const cv::Vec3d p_left = r1m.t() * cv::Vec3d(p[0], p[1], p[2]);
-    depth.at<float>(static_cast<int>(src[i].y), static_cast<int>(src[i].x)) = static_cast<float>(p_left[2]);
+    depth.at<float>(static_cast<int>(src[i].y), static_cast<int>(src[i].x)) =
+        static_cast<float>(p_left[2]);
   }
   return depth;
 }

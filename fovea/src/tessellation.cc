@@ -6,8 +6,10 @@
 namespace fovea {
 
 void TessellationOptions::Check() const {
-  if (!(horizontal_disparity_limit_px > 0)) throw std::invalid_argument("tessellation: horizontal_disparity_limit_px must be positive");
-  if (max_levels < 1 || max_levels > 6) throw std::invalid_argument("tessellation: max_levels must be 1 to 6");
+  if (!(horizontal_disparity_limit_px > 0))
+    throw std::invalid_argument("tessellation: horizontal_disparity_limit_px must be positive");
+  if (max_levels < 1 || max_levels > 6)
+    throw std::invalid_argument("tessellation: max_levels must be 1 to 6");
 }
 
 int Tessellation::LevelAt(int u, int v) const {
@@ -37,7 +39,8 @@ cv::Mat VerticalDisparity(const rig::CameraView& left, const rig::CameraView& ri
   return out;
 }
 
-double AxisHorizontalDisparity(const rig::CameraView& left, const rig::CameraView& right, double z) {
+double AxisHorizontalDisparity(const rig::CameraView& left, const rig::CameraView& right,
+                               double z) {
   const Eigen::Vector3d p_W = left.world_T_camera * Eigen::Vector3d(0, 0, z);
   const Eigen::Vector3d p_R = right.world_T_camera.inverse() * p_W;
   return right.intrinsics.fx_px * p_R.x() / p_R.z();
@@ -59,7 +62,9 @@ Tessellation Tessellate(const rig::CameraView& left, const rig::CameraView& righ
     if (std::abs(AxisHorizontalDisparity(left, right, z0 + sign * hi) - d0) < half_limit) return hi;
     for (int i = 0; i < 60; ++i) {
       const double mid = 0.5 * (lo + hi);
-      (std::abs(AxisHorizontalDisparity(left, right, z0 + sign * mid) - d0) < half_limit ? lo : hi) = mid;
+      (std::abs(AxisHorizontalDisparity(left, right, z0 + sign * mid) - d0) < half_limit ? lo
+                                                                                         : hi) =
+          mid;
     }
     return 0.5 * (lo + hi);
   };
@@ -100,8 +105,10 @@ Tessellation Tessellate(const rig::CameraView& left, const rig::CameraView& righ
     const bool last = level + 1 == options.max_levels || scale >= 1.0;
     if (last) scale = 1.0;
     // Pixels strictly inside |u - cx| < scale hw, |v - cy| < scale hh.
-    const int x0 = static_cast<int>(std::floor(cx - scale * hw)) + 1, x1 = static_cast<int>(std::ceil(cx + scale * hw)) - 1;
-    const int y0 = static_cast<int>(std::floor(cy - scale * hh)) + 1, y1 = static_cast<int>(std::ceil(cy + scale * hh)) - 1;
+    const int x0 = static_cast<int>(std::floor(cx - scale * hw)) + 1,
+              x1 = static_cast<int>(std::ceil(cx + scale * hw)) - 1;
+    const int y0 = static_cast<int>(std::floor(cy - scale * hh)) + 1,
+              y1 = static_cast<int>(std::ceil(cy + scale * hh)) - 1;
     cv::Rect r(std::max(0, x0), std::max(0, y0), 0, 0);
     r.width = std::min(k.width_px - 1, x1) - r.x + 1;
     r.height = std::min(k.height_px - 1, y1) - r.y + 1;

@@ -56,7 +56,8 @@ VergenceSolution Verge(const rig::RigGeometry& g, const rig::RigLimits& limits,
         (c == 0 ? plus.pan_rad : plus.tilt_rad) += h;
         (c == 0 ? minus.pan_rad : minus.tilt_rad) -= h;
         double zp, zm;
-        jac.col(c) = (Normalized(g, side, plus, p_W, &zp) - Normalized(g, side, minus, p_W, &zm)) / (2 * h);
+        jac.col(c) =
+            (Normalized(g, side, plus, p_W, &zp) - Normalized(g, side, minus, p_W, &zm)) / (2 * h);
       }
       const Eigen::Vector2d step = jac.colPivHouseholderQr().solve(-f);
       stage.pan_rad += step.x();
@@ -82,7 +83,8 @@ VergenceSolution Verge(const rig::RigGeometry& g, const rig::RigLimits& limits,
     sol.residual_px[static_cast<int>(side)] = (uv - Eigen::Vector2d(k.cx_px, k.cy_px)).norm();
     if (sol.residual_px[static_cast<int>(side)] > options.tolerance_px) {
       sol.why = std::string(rig::SideName(side)) + " camera: projection " +
-                std::to_string(sol.residual_px[static_cast<int>(side)]) + " px from the principal point";
+                std::to_string(sol.residual_px[static_cast<int>(side)]) +
+                " px from the principal point";
       return sol;
     }
   }

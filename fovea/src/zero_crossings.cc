@@ -9,7 +9,8 @@
 namespace fovea {
 
 void ZeroCrossingOptions::Check() const {
-  if (!(sigma_px >= 0.5 && sigma_px <= 20)) throw std::invalid_argument("zero crossings: sigma_px must be in [0.5, 20]");
+  if (!(sigma_px >= 0.5 && sigma_px <= 20))
+    throw std::invalid_argument("zero crossings: sigma_px must be in [0.5, 20]");
   if (!(min_slope >= 0)) throw std::invalid_argument("zero crossings: min_slope must be >= 0");
 }
 
@@ -19,8 +20,10 @@ ZeroCrossingImage ExtractZeroCrossings(const cv::Mat& gray, const ZeroCrossingOp
   ZeroCrossingImage out;
   cv::Mat f, blurred;
   gray.convertTo(f, CV_32F);
-  cv::GaussianBlur(f, blurred, cv::Size(0, 0), options.sigma_px, options.sigma_px, cv::BORDER_REPLICATE);
-  cv::Laplacian(blurred, out.log, CV_32F, 1, options.sigma_px * options.sigma_px, 0, cv::BORDER_REPLICATE);
+  cv::GaussianBlur(f, blurred, cv::Size(0, 0), options.sigma_px, options.sigma_px,
+                   cv::BORDER_REPLICATE);
+  cv::Laplacian(blurred, out.log, CV_32F, 1, options.sigma_px * options.sigma_px, 0,
+                cv::BORDER_REPLICATE);
   cv::Mat gx, gy;
   cv::Sobel(out.log, gx, CV_32F, 1, 0, 3, 0.125);
   cv::Sobel(out.log, gy, CV_32F, 0, 1, 3, 0.125);

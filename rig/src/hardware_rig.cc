@@ -1,28 +1,31 @@
 #include "rig/hardware_rig.h"
 
+#include <unistd.h>
+
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <future>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <thread>
 
 #include "rig/input_file.h"
 
-#include <filesystem>
-#include <algorithm>
-#include <future>
-#include <thread>
-#include <unistd.h>
-#include <opencv2/calib3d.hpp>
-#include <opencv2/imgproc.hpp>
-
 namespace rig {
 
-CameraSource::CameraSource(const std::string& spec, int width_px, int height_px, std::chrono::milliseconds timeout)
+CameraSource::CameraSource(const std::string& spec, int width_px, int height_px,
+                           std::chrono::milliseconds timeout)
     : spec_(spec), width_px_(width_px), height_px_(height_px), timeout_(timeout) {
   const bool index = !spec.empty() && spec.find_first_not_of("0123456789") == std::string::npos;
   const bool sequence = spec.find('%') != std::string::npos;
   // What does not exist is said plainly (and the video backends, which log
   // on their own, are not asked).
-  const std::string must_exist = sequence ? std::filesystem::path(spec).parent_path().string() : spec;
+  const std::string must_exist =
+      sequence ? std::filesystem::path(spec).parent_path().string() : spec;
   if (!index && !must_exist.empty() && !std::filesystem::exists(must_exist))
-    throw RigError("camera '" + spec + "' cannot be opened: no such " + (sequence ? "folder" : "file or device"));
+    throw RigError("camera '" + spec + "' cannot be opened: no such " +
+                   (sequence ? "folder" : "file or device"));
   bool ok = false;
   try {
     ok = index ? capture_->open(std::stoi(spec), cv::CAP_V4L2)
@@ -41,11 +44,13 @@ CameraSource::CameraSource(const std::string& spec, int width_px, int height_px,
   const int h = static_cast<int>(capture_->get(cv::CAP_PROP_FRAME_HEIGHT));
   if (w > 0 && h > 0 && (w != width_px || h != height_px))
     throw RigError("camera '" + spec + "' gives " + std::to_string(w) + "x" + std::to_string(h) +
-                   " images, the calibration is for " + std::to_string(width_px) + "x" + std::to_string(height_px));
+                   " images, the calibration is for " + std::to_string(width_px) + "x" +
+                   std::to_string(height_px));
 }
 
 cv::Mat CameraSource::Grab() {
-  if (stalled_) throw RigError("camera '" + spec_ + "': stalled earlier (no frame within the timeout)");
+  if (stalled_)
+    throw RigError("camera '" + spec_ + "': stalled earlier (no frame within the timeout)");
   // VideoCapture::read blocks on a device that sends nothing: read on a
   // detached worker (which owns what it touches) and give up after the
   // timeout; a promise's future, unlike std::async's, does not wait for the
@@ -53,25 +58,33 @@ cv::Mat CameraSource::Grab() {
   auto frame = std::make_shared<cv::Mat>();
   auto done = std::make_shared<std::promise<bool>>();
   std::future<bool> read = done->get_future();
-  std::thread([capture = capture_, frame, done] { done->set_value(capture->read(*frame)); }).detach();
+  std::thread([capture = capture_, frame, done] {
+    done->set_value(capture->read(*frame));
+  }).detach();
   if (read.wait_for(timeout_) != std::future_status::ready) {
     stalled_ = true;
-    throw RigError("camera '" + spec_ + "': no frame within " + std::to_string(timeout_.count()) + " ms");
+    throw RigError("camera '" + spec_ + "': no frame within " + std::to_string(timeout_.count()) +
+                   " ms");
   }
   if (!read.get() || frame->empty()) throw RigError("camera '" + spec_ + "': no more frames");
   if (frame->cols != width_px_ || frame->rows != height_px_)
-    throw RigError("camera '" + spec_ + "' gives " + std::to_string(frame->cols) + "x" + std::to_string(frame->rows) +
-                   " images, the calibration is for " + std::to_string(width_px_) + "x" + std::to_string(height_px_));
+    throw RigError("camera '" + spec_ + "' gives " + std::to_string(frame->cols) + "x" +
+                   std::to_string(frame->rows) + " images, the calibration is for " +
+                   std::to_string(width_px_) + "x" + std::to_string(height_px_));
   cv::Mat gray;
-  if (frame->channels() == 3) cv::cvtColor(*frame, gray, cv::COLOR_BGR2GRAY);
-  else if (frame->channels() == 4) cv::cvtColor(*frame, gray, cv::COLOR_BGRA2GRAY);
-  else gray = *frame;
+  if (frame->channels() == 3)
+    cv::cvtColor(*frame, gray, cv::COLOR_BGR2GRAY);
+  else if (frame->channels() == 4)
+    cv::cvtColor(*frame, gray, cv::COLOR_BGRA2GRAY);
+  else
+    gray = *frame;
   return gray;
 }
 
 namespace {
 
-void WriteCamera(cv::FileStorage& fs, const char* name, const CameraIntrinsics& k, const Eigen::Vector3d& offset) {
+void WriteCamera(cv::FileStorage& fs, const char* name, const CameraIntrinsics& k,
+                 const Eigen::Vector3d& offset) {
   fs << name << "{";
   fs << "width_px" << k.width_px << "height_px" << k.height_px;
   fs << "fx_px" << k.fx_px << "fy_px" << k.fy_px << "cx_px" << k.cx_px << "cy_px" << k.cy_px;
@@ -80,15 +93,16 @@ void WriteCamera(cv::FileStorage& fs, const char* name, const CameraIntrinsics& 
   fs << "}";
 }
 
-void ReadCamera(const cv::FileStorage& fs, const std::string& path, const char* name, CameraIntrinsics* k,
-                Eigen::Vector3d* offset) {
+void ReadCamera(const cv::FileStorage& fs, const std::string& path, const char* name,
+                CameraIntrinsics* k, Eigen::Vector3d* offset) {
   const cv::FileNode n = fs[name];
   auto fail = [&](const std::string& what) {
     throw InputError("calibration " + ClipForMessage(path) + ": " + name + ": " + what);
   };
   if (n.empty() || !n.isMap()) fail("missing");
   for (const char* key : {"width_px", "height_px", "fx_px", "fy_px", "cx_px", "cy_px"})
-    if (n[key].empty() || (!n[key].isReal() && !n[key].isInt())) fail(std::string("missing number '") + key + "'");
+    if (n[key].empty() || (!n[key].isReal() && !n[key].isInt()))
+      fail(std::string("missing number '") + key + "'");
   k->width_px = static_cast<int>(n["width_px"]);
   k->height_px = static_cast<int>(n["height_px"]);
   k->fx_px = static_cast<double>(n["fx_px"]);
@@ -120,7 +134,8 @@ RigCalibration LoadCalibration(const std::string& path) {
     fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY);
   } catch (const cv::Exception&) {
   }
-  if (!fs.isOpened()) throw InputError("calibration '" + ClipForMessage(path) + "' cannot be read (not OpenCV YAML)");
+  if (!fs.isOpened())
+    throw InputError("calibration '" + ClipForMessage(path) + "' cannot be read (not OpenCV YAML)");
   RigCalibration c;
   ReadCamera(fs, path, "left", &c.left, &c.left_optical_centre_H);
   ReadCamera(fs, path, "right", &c.right, &c.right_optical_centre_H);
@@ -142,8 +157,8 @@ HardwareRig::HardwareRig(HardwareRigConfig config) : calibration_(config.calibra
   geometry_.left.optical_centre_H = calibration_.left_optical_centre_H;
   geometry_.right.optical_centre_H = calibration_.right_optical_centre_H;
   home_ = limits_.Quantize(StageState::Parallel(config.home_baseline_m));
-  left_ = std::make_unique<CameraSource>(config.left_camera, calibration_.left.width_px, calibration_.left.height_px,
-                                         config.frame_timeout);
+  left_ = std::make_unique<CameraSource>(config.left_camera, calibration_.left.width_px,
+                                         calibration_.left.height_px, config.frame_timeout);
   right_ = std::make_unique<CameraSource>(config.right_camera, calibration_.right.width_px,
                                           calibration_.right.height_px, config.frame_timeout);
   driver_ = std::make_unique<IndexerDriver>(std::move(config.line), config.stages);
@@ -169,7 +184,8 @@ CameraIntrinsics HardwareRig::Intrinsics(Side side) const {
 StereoFrame HardwareRig::Capture(const CaptureOptions&) {
   StereoFrame frame;
   frame.state = state_;
-  frame.timestamp_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  frame.timestamp_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   for (const Side side : {Side::kLeft, Side::kRight}) {
     CameraView& view = side == Side::kLeft ? frame.left : frame.right;
     const cv::Mat raw = (side == Side::kLeft ? left_ : right_)->Grab();

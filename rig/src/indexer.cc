@@ -1,6 +1,7 @@
 #include "rig/indexer.h"
 
 #include <fcntl.h>
+#include <libserial/SerialPort.h>
 #include <poll.h>
 #include <pty.h>
 #include <signal.h>
@@ -8,11 +9,10 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cctype>
+#include <cerrno>
 #include <cmath>
 #include <cstring>
-#include <libserial/SerialPort.h>
 #include <thread>
 
 #include "rig/input_file.h"
@@ -48,8 +48,9 @@ int RegisterKill(int fd, const std::string& bytes) {
   if (fd < 0 || bytes.size() > sizeof(KillSlot::bytes)) return -1;
   // Ours goes in front of whatever handles the signal now (installed again
   // if someone replaced it since), and hands the signal on to it.
-  for (const auto& [sig, previous] : {std::pair<int, struct sigaction*>{SIGINT, &g_previous_int},
-                                      std::pair<int, struct sigaction*>{SIGTERM, &g_previous_term}}) {
+  for (const auto& [sig, previous] :
+       {std::pair<int, struct sigaction*>{SIGINT, &g_previous_int},
+        std::pair<int, struct sigaction*>{SIGTERM, &g_previous_term}}) {
     struct sigaction now {};
     sigaction(sig, nullptr, &now);
     if (now.sa_handler == KillOnSignal) continue;
@@ -95,9 +96,11 @@ class LibSerialLine : public SerialLine {
     const int fd = port_.GetFileDescriptor();
     pollfd p{fd, POLLIN, 0};
     const int r = ::poll(&p, 1, static_cast<int>(timeout.count()));
-    if (r < 0 && errno != EINTR) throw RigError("serial port '" + name_ + "': " + std::strerror(errno));
+    if (r < 0 && errno != EINTR)
+      throw RigError("serial port '" + name_ + "': " + std::strerror(errno));
     if (r <= 0) return "";
-    if (p.revents & (POLLHUP | POLLERR | POLLNVAL)) throw RigError("serial port '" + name_ + "': the line was closed");
+    if (p.revents & (POLLHUP | POLLERR | POLLNVAL))
+      throw RigError("serial port '" + name_ + "': the line was closed");
     char buf[512];
     const ssize_t n = ::read(fd, buf, sizeof buf);
     if (n == 0 || (n < 0 && errno != EAGAIN && errno != EINTR))
@@ -168,7 +171,8 @@ IndexerDialect::Reply IndexerDialect::ParseReply(const std::string& received) co
 std::optional<long> IndexerDialect::ParsePosition(const std::string& reply) const {
   if (reply.rfind(position_reply, 0) != 0) return std::nullopt;
   const char* number = reply.c_str() + position_reply.size();
-  if (*number != '+' && *number != '-' && !std::isdigit(static_cast<unsigned char>(*number))) return std::nullopt;
+  if (*number != '+' && *number != '-' && !std::isdigit(static_cast<unsigned char>(*number)))
+    return std::nullopt;
   errno = 0;
   char* end = nullptr;
   const long v = std::strtol(number, &end, 10);
@@ -181,14 +185,17 @@ std::optional<std::string> IndexerDialect::ParseStatus(const std::string& reply)
   std::string bits;
   for (size_t i = status_reply.size(); i < reply.size(); ++i) {
     const char c = reply[i];
-    if (c == '0' || c == '1') bits += c;
-    else if (c != '_') return std::nullopt;
+    if (c == '0' || c == '1')
+      bits += c;
+    else if (c != '_')
+      return std::nullopt;
   }
   if (bits.size() != 32) return std::nullopt;
   return bits;
 }
 
-std::string IndexerDialect::Format(IndexerCommand command, int unit, const std::string& value) const {
+std::string IndexerDialect::Format(IndexerCommand command, int unit,
+                                   const std::string& value) const {
   std::string t = templates[static_cast<int>(command)];
   for (size_t p; (p = t.find("{u}")) != std::string::npos;) t.replace(p, 3, std::to_string(unit));
   for (size_t p; (p = t.find("{v}")) != std::string::npos;) t.replace(p, 3, value);
@@ -221,7 +228,8 @@ void CheckSerialDevice(const std::string& port) {
   const std::string name = "serial port '" + ClipForMessage(port) + "'";
   struct stat st {};
   if (::stat(port.c_str(), &st) != 0) throw InputError(name + " does not exist");
-  if (!S_ISCHR(st.st_mode)) throw InputError(name + " is not a serial device (not a character device)");
+  if (!S_ISCHR(st.st_mode))
+    throw InputError(name + " is not a serial device (not a character device)");
   const int fd = ::open(port.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
   if (fd < 0) throw RigError(name + " cannot be opened: " + std::strerror(errno));
   const bool tty = ::isatty(fd);
@@ -231,32 +239,37 @@ void CheckSerialDevice(const std::string& port) {
 
 std::unique_ptr<SerialLine> OpenSerialPort(const std::string& port, int baud) {
   static const std::pair<int, LibSerial::BaudRate> kRates[] = {
-      {1200, LibSerial::BaudRate::BAUD_1200},     {2400, LibSerial::BaudRate::BAUD_2400},
-      {4800, LibSerial::BaudRate::BAUD_4800},     {9600, LibSerial::BaudRate::BAUD_9600},
-      {19200, LibSerial::BaudRate::BAUD_19200},   {38400, LibSerial::BaudRate::BAUD_38400},
-      {57600, LibSerial::BaudRate::BAUD_57600},   {115200, LibSerial::BaudRate::BAUD_115200},
+      {1200, LibSerial::BaudRate::BAUD_1200},    {2400, LibSerial::BaudRate::BAUD_2400},
+      {4800, LibSerial::BaudRate::BAUD_4800},    {9600, LibSerial::BaudRate::BAUD_9600},
+      {19200, LibSerial::BaudRate::BAUD_19200},  {38400, LibSerial::BaudRate::BAUD_38400},
+      {57600, LibSerial::BaudRate::BAUD_57600},  {115200, LibSerial::BaudRate::BAUD_115200},
       {230400, LibSerial::BaudRate::BAUD_230400}};
   for (const auto& [rate, code] : kRates)
     if (rate == baud) {
       CheckSerialDevice(port);
       return std::make_unique<LibSerialLine>(port, code);
     }
-  throw RigError("serial baud rate " + std::to_string(baud) +
-                 " is not a standard rate (1200, 2400, 4800, 9600, 19200, 38400, 57600, 115200, 230400)");
+  throw RigError(
+      "serial baud rate " + std::to_string(baud) +
+      " is not a standard rate (1200, 2400, 4800, 9600, 19200, 38400, 57600, 115200, 230400)");
 }
 
 void IndexerOptions::Check() const {
   for (int i = 0; i < kNumAxes; ++i) {
     const IndexerAxis& a = axes[i];
     const std::string name = AxisName(static_cast<Axis>(i));
-    if (a.unit < 1 || a.unit > 99) throw RigError("indexer axis " + name + ": unit must be 1 to 99");
-    if (!(a.steps_per_unit > 0)) throw RigError("indexer axis " + name + ": steps_per_unit must be positive");
-    if (a.sign != 1 && a.sign != -1) throw RigError("indexer axis " + name + ": sign must be +1 or -1");
+    if (a.unit < 1 || a.unit > 99)
+      throw RigError("indexer axis " + name + ": unit must be 1 to 99");
+    if (!(a.steps_per_unit > 0))
+      throw RigError("indexer axis " + name + ": steps_per_unit must be positive");
+    if (a.sign != 1 && a.sign != -1)
+      throw RigError("indexer axis " + name + ": sign must be +1 or -1");
     if (!(a.velocity > 0) || !(a.acceleration > 0))
       throw RigError("indexer axis " + name + ": velocity and acceleration must be positive");
     if (!(a.max > a.min)) throw RigError("indexer axis " + name + ": soft limits need min < max");
     for (int j = 0; j < i; ++j)
-      if (axes[j].unit == a.unit) throw RigError("indexer axis " + name + ": unit " + std::to_string(a.unit) + " used twice");
+      if (axes[j].unit == a.unit)
+        throw RigError("indexer axis " + name + ": unit " + std::to_string(a.unit) + " used twice");
   }
   if (reply_timeout.count() <= 0) throw RigError("indexer: reply_timeout must be positive");
 }
@@ -291,18 +304,21 @@ std::string IndexerDriver::Exchange(const std::string& command, const std::strin
     const auto deadline = Clock::now() + timeout;
     std::string buf;
     while (true) {
-      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+      const auto left =
+          std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
       if (left.count() <= 0) break;
       buf += line_->ReadSome(left);
       const IndexerDialect::Reply reply = dialect_.ParseReply(buf);
-      if (reply.status == IndexerDialect::Reply::kGarbled) throw RigError(what + ": garbled reply from the indexer");
+      if (reply.status == IndexerDialect::Reply::kGarbled)
+        throw RigError(what + ": garbled reply from the indexer");
       if (reply.status == IndexerDialect::Reply::kRejected)
         throw RigError(what + ": the indexer rejected it: " + ClipForMessage(reply.text));
       if (reply.status == IndexerDialect::Reply::kOk) return reply.text;
     }
   }
-  throw RigError(what + ": no complete reply within " + std::to_string(options_.reply_timeout.count()) +
-                 " ms (tried " + std::to_string(options_.retries + 1) + " times)");
+  throw RigError(what + ": no complete reply within " +
+                 std::to_string(options_.reply_timeout.count()) + " ms (tried " +
+                 std::to_string(options_.retries + 1) + " times)");
 }
 
 std::string IndexerDriver::Send(IndexerCommand command, int unit, const std::string& value) {
@@ -330,7 +346,9 @@ std::array<long, kNumAxes> IndexerDriver::PositionSteps() {
     const int unit = options_.axes[i].unit;
     const std::string reply = Send(IndexerCommand::kPositionReport, unit);
     const std::optional<long> v = dialect_.ParsePosition(reply);
-    if (!v) Fail("unit " + std::to_string(unit) + ": unreadable position report '" + ClipForMessage(reply) + "'");
+    if (!v)
+      Fail("unit " + std::to_string(unit) + ": unreadable position report '" +
+           ClipForMessage(reply) + "'");
     steps[i] = *v;
   }
   return steps;
@@ -347,7 +365,9 @@ std::string IndexerDriver::Status(Axis axis) {
   const int unit = options_.axes[static_cast<int>(axis)].unit;
   const std::string reply = Send(IndexerCommand::kStatus, unit);
   const std::optional<std::string> bits = dialect_.ParseStatus(reply);
-  if (!bits) Fail("unit " + std::to_string(unit) + ": unreadable status report '" + ClipForMessage(reply) + "'");
+  if (!bits)
+    Fail("unit " + std::to_string(unit) + ": unreadable status report '" + ClipForMessage(reply) +
+         "'");
   return *bits;
 }
 
@@ -372,8 +392,9 @@ MoveResult IndexerDriver::MoveTo(const StageState& target) {
   for (int i = 0; i < kNumAxes; ++i) {
     const IndexerAxis& a = options_.axes[i];
     if (!(values[i] >= a.min - 1e-12 && values[i] <= a.max + 1e-12))
-      throw RigError(std::string("move refused: ") + AxisName(static_cast<Axis>(i)) + " " + std::to_string(values[i]) +
-                     " is outside its soft limits [" + std::to_string(a.min) + ", " + std::to_string(a.max) + "]");
+      throw RigError(std::string("move refused: ") + AxisName(static_cast<Axis>(i)) + " " +
+                     std::to_string(values[i]) + " is outside its soft limits [" +
+                     std::to_string(a.min) + ", " + std::to_string(a.max) + "]");
   }
   const auto t0 = Clock::now();
   const auto start = PositionSteps();
@@ -395,8 +416,9 @@ MoveResult IndexerDriver::MoveTo(const StageState& target) {
   }
   move_pending_ = true;
   for (const IndexerAxis& a : options_.axes) Send(IndexerCommand::kGo, a.unit);
-  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                           std::chrono::duration<double>(2 * profile_s + options_.move_timeout_margin_s));
+  const auto deadline =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
+                         2 * profile_s + options_.move_timeout_margin_s));
   for (bool moving = true; moving;) {
     std::this_thread::sleep_for(options_.poll_interval);
     moving = false;
@@ -409,14 +431,16 @@ MoveResult IndexerDriver::MoveTo(const StageState& target) {
       moving |= bits[dialect_.moving_bit] == '1';
     }
     if (moving && Clock::now() > deadline)
-      Fail("move did not finish within " + std::to_string(2 * profile_s + options_.move_timeout_margin_s) + " s");
+      Fail("move did not finish within " +
+           std::to_string(2 * profile_s + options_.move_timeout_margin_s) + " s");
   }
   move_pending_ = false;
   const auto reached = PositionSteps();
   for (int i = 0; i < kNumAxes; ++i)
     if (std::labs(reached[i] - goal[i]) > options_.position_tolerance_steps)
-      Fail("unit " + std::to_string(options_.axes[i].unit) + ": position " + std::to_string(reached[i]) +
-           " steps after the move, commanded " + std::to_string(goal[i]));
+      Fail("unit " + std::to_string(options_.axes[i].unit) + ": position " +
+           std::to_string(reached[i]) + " steps after the move, commanded " +
+           std::to_string(goal[i]));
   MoveResult r;
   r.motion_time_s = std::chrono::duration<double>(Clock::now() - t0).count();
   std::array<double, kNumAxes> v{};

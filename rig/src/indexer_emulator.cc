@@ -19,7 +19,8 @@ IndexerEmulator::IndexerEmulator(const std::vector<int>& units) {
   termios raw{};
   cfmakeraw(&raw);
   char name[256];
-  if (openpty(&master_, &slave_, name, &raw, nullptr) != 0) throw std::runtime_error("indexer emulator: openpty failed");
+  if (openpty(&master_, &slave_, name, &raw, nullptr) != 0)
+    throw std::runtime_error("indexer emulator: openpty failed");
   path_ = name;
   thread_ = std::thread([this] { Serve(); });
 }
@@ -53,7 +54,8 @@ bool IndexerEmulator::Moving(int unit) const {
   std::lock_guard<std::mutex> lock(mutex_);
   const auto it = units_.find(unit);
   if (it == units_.end() || !it->second.moving) return false;
-  return std::chrono::duration<double>(Clock::now() - it->second.start).count() < it->second.duration_s;
+  return std::chrono::duration<double>(Clock::now() - it->second.start).count() <
+         it->second.duration_s;
 }
 
 std::vector<std::string> IndexerEmulator::Received() const {
@@ -70,9 +72,12 @@ long IndexerEmulator::Now(const Unit& u) const {
   const double v = std::min(u.velocity, std::sqrt(d * a));
   const double ta = v / a, tc = u.duration_s - 2 * ta;
   double s;
-  if (t < ta) s = 0.5 * a * t * t;
-  else if (t < ta + tc) s = 0.5 * a * ta * ta + v * (t - ta);
-  else s = d - 0.5 * a * (u.duration_s - t) * (u.duration_s - t);
+  if (t < ta)
+    s = 0.5 * a * t * t;
+  else if (t < ta + tc)
+    s = 0.5 * a * ta * ta + v * (t - ta);
+  else
+    s = d - 0.5 * a * (u.duration_s - t) * (u.duration_s - t);
   const double sign = u.target >= u.position ? 1 : -1;
   return u.position + static_cast<long>(std::lround(sign * std::min(s, d)));
 }
@@ -145,7 +150,8 @@ std::string IndexerEmulator::Handle(const std::string& raw) {
   }
   if (line == "GO1") {
     if (u.moving) return Reply("MOTION IN PROGRESS", false);
-    if (fault_ == IndexerFault::kFaultStatus) return Reply("", true);  // a faulted drive does not move
+    if (fault_ == IndexerFault::kFaultStatus)
+      return Reply("", true);  // a faulted drive does not move
     u.target = u.absolute ? u.distance : u.position + u.distance;
     const double d = std::abs(double(u.target - u.position));
     const double a = u.acceleration, vmax = u.velocity;
@@ -156,7 +162,8 @@ std::string IndexerEmulator::Handle(const std::string& raw) {
   }
   if (line.rfind("A", 0) == 0 && number(1, &v) && v > 0) return u.acceleration = v, Reply("", true);
   if (line.rfind("V", 0) == 0 && number(1, &v) && v > 0) return u.velocity = v, Reply("", true);
-  if (line.rfind("D", 0) == 0 && number(1, &v) && v == std::floor(v)) return u.distance = static_cast<long>(v), Reply("", true);
+  if (line.rfind("D", 0) == 0 && number(1, &v) && v == std::floor(v))
+    return u.distance = static_cast<long>(v), Reply("", true);
   return Reply("INVALID COMMAND OR VALUE '" + line + "'", false);
 }
 
@@ -196,9 +203,15 @@ void IndexerEmulator::Serve() {
         delay = delay_;
       }
       switch (fault) {
-        case IndexerFault::kNoReply: reply.clear(); break;
-        case IndexerFault::kGarbled: reply = "\x9f\xa3\xff\x01#\r\n> "; break;
-        case IndexerFault::kPartialLine: reply = reply.substr(0, reply.size() / 2 > 4 ? 4 : reply.size() / 2); break;
+        case IndexerFault::kNoReply:
+          reply.clear();
+          break;
+        case IndexerFault::kGarbled:
+          reply = "\x9f\xa3\xff\x01#\r\n> ";
+          break;
+        case IndexerFault::kPartialLine:
+          reply = reply.substr(0, reply.size() / 2 > 4 ? 4 : reply.size() / 2);
+          break;
         case IndexerFault::kDropConnection:
           close(master_);
           close(slave_);
@@ -209,7 +222,8 @@ void IndexerEmulator::Serve() {
           late.emplace_back(Clock::now() + delay, reply);
           reply.clear();
           break;
-        default: break;
+        default:
+          break;
       }
       if (master_ < 0) break;
       if (!reply.empty()) {

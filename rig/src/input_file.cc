@@ -16,7 +16,8 @@ void CheckInputFile(const std::string& path, const std::string& what, std::uintm
   const fs::file_status status = fs::status(path, ec);
   if (ec || !fs::exists(status)) throw InputError(name + " cannot be read: no such file");
   if (fs::is_directory(status)) throw InputError(name + " is a folder, not a file");
-  if (!fs::is_regular_file(status)) throw InputError(name + " is not a regular file (a device, pipe or socket)");
+  if (!fs::is_regular_file(status))
+    throw InputError(name + " is not a regular file (a device, pipe or socket)");
   const std::uintmax_t size = fs::file_size(path, ec);
   if (ec) throw InputError(name + " cannot be read: " + ec.message());
   if (size > max_bytes)
@@ -24,10 +25,13 @@ void CheckInputFile(const std::string& path, const std::string& what, std::uintm
                      std::to_string(max_bytes >> 20) + " MiB");
 }
 
-std::string ReadInputFile(const std::string& path, const std::string& what, std::uintmax_t max_bytes) {
+std::string ReadInputFile(const std::string& path, const std::string& what,
+                          std::uintmax_t max_bytes) {
   CheckInputFile(path, what, max_bytes);
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(what + " '" + ClipForMessage(path) + "' cannot be read: " + std::strerror(errno));
+  if (!in)
+    throw InputError(what + " '" + ClipForMessage(path) +
+                     "' cannot be read: " + std::strerror(errno));
   // At most max_bytes + 1: the file may have grown since it was checked.
   std::string all;
   char buf[1 << 16];
@@ -36,9 +40,10 @@ std::string ReadInputFile(const std::string& path, const std::string& what, std:
     all.append(buf, static_cast<size_t>(in.gcount()));
   }
   if (all.size() > max_bytes)
-    throw InputError(what + " '" + ClipForMessage(path) + "' is over the limit of " + std::to_string(max_bytes >> 20) +
-                     " MiB");
-  if (in.bad()) throw InputError(what + " '" + ClipForMessage(path) + "' cannot be read: read error");
+    throw InputError(what + " '" + ClipForMessage(path) + "' is over the limit of " +
+                     std::to_string(max_bytes >> 20) + " MiB");
+  if (in.bad())
+    throw InputError(what + " '" + ClipForMessage(path) + "' cannot be read: read error");
   return all;
 }
 

@@ -23,7 +23,8 @@ Eigen::Isometry3d RigGeometry::WorldFromHead(Side side, const CameraStage& stage
   return world_T_head;
 }
 
-CameraStage RigGeometry::FacingStage(Side side, double carriage_m, const Eigen::Vector3d& p_W) const {
+CameraStage RigGeometry::FacingStage(Side side, double carriage_m,
+                                     const Eigen::Vector3d& p_W) const {
   const Eigen::Vector3d v = p_W - WorldFromHead(side, {carriage_m, 0, 0}).translation();
   return {carriage_m, std::atan2(-v.x(), v.y()), std::atan2(v.z(), std::hypot(v.x(), v.y()))};
 }

@@ -17,7 +17,9 @@ RigGeometry LeftPairGeometry(const RigGeometry& geometry) {
 }
 
 LeftCameraPair::LeftCameraPair(Rig& rig)
-    : rig_(rig), limits_(LeftPairLimits(rig.Limits())), geometry_(LeftPairGeometry(rig.Geometry())) {}
+    : rig_(rig),
+      limits_(LeftPairLimits(rig.Limits())),
+      geometry_(LeftPairGeometry(rig.Geometry())) {}
 
 MoveResult LeftCameraPair::MoveTo(const StageState& target) {
   const StageState q = limits_.Quantize(target);

@@ -10,12 +10,18 @@ const char* SideName(Side side) { return side == Side::kLeft ? "left" : "right";
 
 const char* AxisName(Axis axis) {
   switch (axis) {
-    case Axis::kLeftBaseline: return "left baseline";
-    case Axis::kLeftPan: return "left pan";
-    case Axis::kLeftTilt: return "left tilt";
-    case Axis::kRightBaseline: return "right baseline";
-    case Axis::kRightPan: return "right pan";
-    case Axis::kRightTilt: return "right tilt";
+    case Axis::kLeftBaseline:
+      return "left baseline";
+    case Axis::kLeftPan:
+      return "left pan";
+    case Axis::kLeftTilt:
+      return "left tilt";
+    case Axis::kRightBaseline:
+      return "right baseline";
+    case Axis::kRightPan:
+      return "right pan";
+    case Axis::kRightTilt:
+      return "right tilt";
   }
   return "?";
 }
@@ -117,8 +123,8 @@ StageState StageState::FromArray(const std::array<double, kNumAxes>& v) {
 }
 
 std::array<double, kNumAxes> StageState::ToArray() const {
-  return {left.baseline_m, left.pan_rad, left.tilt_rad, right.baseline_m, right.pan_rad,
-          right.tilt_rad};
+  return {left.baseline_m,  left.pan_rad,  left.tilt_rad,
+          right.baseline_m, right.pan_rad, right.tilt_rad};
 }
 
 std::string StageState::ToString() const {

@@ -29,8 +29,8 @@ std::string ResolveScene(const std::string& name_or_path) {
     if (name == name_or_path) return ScenesDir() + "/" + name + ".xml";
   std::string names;
   for (const auto& name : CatalogNames()) names += (names.empty() ? "" : ", ") + name;
-  throw sim::SceneError("unknown scene '" + rig::ClipForMessage(name_or_path) + "' (catalog: " + names +
-                        "; or give a path to an .xml file)");
+  throw sim::SceneError("unknown scene '" + rig::ClipForMessage(name_or_path) +
+                        "' (catalog: " + names + "; or give a path to an .xml file)");
 }
 
 sim::AssetProvider TextureProvider() {

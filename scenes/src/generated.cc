@@ -22,7 +22,8 @@ std::optional<std::string> MakeMesh(const std::string& file_name) {
   obj << "# open cylinder r=" << r << " m h=" << h << " m\n";
   for (int i = 0; i <= n; ++i) {
     const double a = 2 * M_PI * i / n;
-    for (double z : {-h / 2, h / 2}) obj << "v " << r * std::cos(a) << " " << r * std::sin(a) << " " << z << "\n";
+    for (double z : {-h / 2, h / 2})
+      obj << "v " << r * std::cos(a) << " " << r * std::sin(a) << " " << z << "\n";
   }
   for (int i = 0; i <= n; ++i) {
     const double u = kTexTilesPerMetre * r * 2 * M_PI * i / n;
@@ -78,22 +79,25 @@ std::string RandomSceneXml(const RandomSceneSpec& spec) {
     bodies << "    <geom name=\"object_" << i << "\" ";
     if (type == 0) {  // box, turned about the vertical
       const double yaw = rng.uniform(-M_PI / 4, M_PI / 4);
-      bodies << "type=\"box\" size=\"" << rng.uniform(0.03, 0.1) * y << " " << rng.uniform(0.03, 0.1) * y
-             << " " << rng.uniform(0.03, 0.1) * y << "\" pos=\"" << x << " " << y << " " << z
-             << "\" xyaxes=\"" << std::cos(yaw) << " " << std::sin(yaw) << " 0 " << -std::sin(yaw)
-             << " " << std::cos(yaw) << " 0\"";
+      bodies << "type=\"box\" size=\"" << rng.uniform(0.03, 0.1) * y << " "
+             << rng.uniform(0.03, 0.1) * y << " " << rng.uniform(0.03, 0.1) * y << "\" pos=\"" << x
+             << " " << y << " " << z << "\" xyaxes=\"" << std::cos(yaw) << " " << std::sin(yaw)
+             << " 0 " << -std::sin(yaw) << " " << std::cos(yaw) << " 0\"";
     } else if (type == 1) {  // vertical cylinder
       const int r_mm = int(rng.uniform(30, 81) * y), h_mm = rng.uniform(200, 601);
       assets << "    <mesh name=\"mesh" << i << "\" file=\"cylinder-r" << r_mm << "-h" << h_mm
              << ".obj\"/>\n";
-      bodies << "type=\"mesh\" mesh=\"mesh" << i << "\" pos=\"" << x << " " << y << " " << z << "\"";
+      bodies << "type=\"mesh\" mesh=\"mesh" << i << "\" pos=\"" << x << " " << y << " " << z
+             << "\"";
     } else {  // slanted plane: yaw up to 60 degrees, pitch up to 30
       const double yaw = rng.uniform(-M_PI / 3, M_PI / 3), pitch = rng.uniform(-M_PI / 6, M_PI / 6);
       const cv::Vec3d ax(std::cos(yaw), std::sin(yaw), 0);
-      const cv::Vec3d ay(-std::sin(yaw) * std::sin(pitch), std::cos(yaw) * std::sin(pitch), std::cos(pitch));
-      bodies << "type=\"box\" size=\"" << rng.uniform(0.04, 0.15) * y << " " << rng.uniform(0.04, 0.15) * y
-             << " 0.005\" pos=\"" << x << " " << y << " " << z << "\" xyaxes=\"" << ax[0] << " "
-             << ax[1] << " " << ax[2] << " " << ay[0] << " " << ay[1] << " " << ay[2] << "\"";
+      const cv::Vec3d ay(-std::sin(yaw) * std::sin(pitch), std::cos(yaw) * std::sin(pitch),
+                         std::cos(pitch));
+      bodies << "type=\"box\" size=\"" << rng.uniform(0.04, 0.15) * y << " "
+             << rng.uniform(0.04, 0.15) * y << " 0.005\" pos=\"" << x << " " << y << " " << z
+             << "\" xyaxes=\"" << ax[0] << " " << ax[1] << " " << ax[2] << " " << ay[0] << " "
+             << ay[1] << " " << ay[2] << "\"";
     }
     bodies << " material=\"" << mat << "\"/>\n";
   }

@@ -46,7 +46,8 @@ Mat Colorize(const Mat& t, cv::Vec3f dark, cv::Vec3f light) {
     cv::Vec3b* dst = out.ptr<cv::Vec3b>(r);
     for (int c = 0; c < t.cols; ++c) {
       const float s = std::clamp(src[c], 0.0f, 1.0f);
-      for (int ch = 0; ch < 3; ++ch) dst[c][ch] = cv::saturate_cast<uchar>(dark[ch] + s * (light[ch] - dark[ch]));
+      for (int ch = 0; ch < 3; ++ch)
+        dst[c][ch] = cv::saturate_cast<uchar>(dark[ch] + s * (light[ch] - dark[ch]));
     }
   }
   return out;
@@ -82,8 +83,9 @@ Mat Grain(cv::RNG& rng, int size, double rings_per_tile, double warp, double fib
                        0.15 * warp * (ripple.at<float>(r, c) - 0.5);
       const double phase = rings_per_tile * x;
       const double ring = std::pow(0.5 + 0.5 * std::sin(2 * M_PI * phase), 3.0);
-      t.at<float>(r, c) = float(0.15 + 0.55 * ring + fibre_contrast * (fibres.at<float>(r, c) - 0.5) +
-                                0.12 * (speckle.at<float>(r, c) - 0.5));
+      t.at<float>(r, c) =
+          float(0.15 + 0.55 * ring + fibre_contrast * (fibres.at<float>(r, c) - 0.5) +
+                0.12 * (speckle.at<float>(r, c) - 0.5));
     }
   return Colorize(t, dark, light);
 }
@@ -158,8 +160,10 @@ Mat Plywood(cv::RNG& rng, int size) {
 Mat Periodic(cv::RNG& rng, int size, bool checker) {
   const int p = kPeriodicPeriodPx;
   const int phase = rng.uniform(0, p);
-  const cv::Vec3f a(float(rng.uniform(10, 60)), float(rng.uniform(10, 60)), float(rng.uniform(10, 60)));
-  const cv::Vec3f b(float(rng.uniform(190, 250)), float(rng.uniform(190, 250)), float(rng.uniform(190, 250)));
+  const cv::Vec3f a(float(rng.uniform(10, 60)), float(rng.uniform(10, 60)),
+                    float(rng.uniform(10, 60)));
+  const cv::Vec3f b(float(rng.uniform(190, 250)), float(rng.uniform(190, 250)),
+                    float(rng.uniform(190, 250)));
   auto wave = [&](int i) {
     // +1 on the first half period, -1 on the second, one-texel ramps.
     const double x = (i + phase) % p + 0.5;

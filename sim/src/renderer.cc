@@ -36,8 +36,8 @@ OffscreenRenderer::~OffscreenRenderer() {
   OSMesaDestroyContext(context_);
 }
 
-void OffscreenRenderer::Render(const mjModel* m, mjData* d, int cam_id, int width_px,
-                               int height_px, cv::Mat* rgb, cv::Mat* depth_m) {
+void OffscreenRenderer::Render(const mjModel* m, mjData* d, int cam_id, int width_px, int height_px,
+                               cv::Mat* rgb, cv::Mat* depth_m) {
   // Several renderers may live in one process (tests): make ours current.
   OSMesaMakeCurrent(context_, window_buffer_.data(), GL_UNSIGNED_BYTE, width_px_, height_px_);
   mjr_setBuffer(mjFB_OFFSCREEN, &context_mj_);
@@ -86,9 +86,8 @@ Eigen::Isometry3d CameraPoseFromMujoco(const mjData* d, int cam_id) {
   // MuJoCo camera axes: x right, y up, looking along -z. OpenCV: x right, y
   // down, z forward. So OpenCV = MuJoCo * diag(1, -1, -1).
   world_T_camera.linear() = world_R_mj * Eigen::Vector3d(1, -1, -1).asDiagonal();
-  world_T_camera.translation() =
-      Eigen::Vector3d(d->cam_xpos[3 * cam_id], d->cam_xpos[3 * cam_id + 1],
-                      d->cam_xpos[3 * cam_id + 2]);
+  world_T_camera.translation() = Eigen::Vector3d(
+      d->cam_xpos[3 * cam_id], d->cam_xpos[3 * cam_id + 1], d->cam_xpos[3 * cam_id + 2]);
   return world_T_camera;
 }
 

@@ -44,7 +44,8 @@ std::string RigMjcf(const SimRigConfig& c) {
   x << R"(<mujoco model="tavt">
   <option timestep="0.001" gravity="0 0 0"/>
   <visual>
-    <global offwidth=")" << c.width_px << R"(" offheight=")" << c.height_px << R"("/>
+    <global offwidth=")"
+    << c.width_px << R"(" offheight=")" << c.height_px << R"("/>
     <quality offsamples="4"/>
     <headlight ambient="0.25 0.25 0.25" diffuse="0 0 0" specular="0 0 0"/>
   </visual>
@@ -54,9 +55,11 @@ std::string RigMjcf(const SimRigConfig& c) {
     </default>
   </default>
   <worldbody>
-    <camera name="tavt_truth" pos="0 0 0" xyaxes="1 0 0 0 0 1" fovy=")" << fovy_deg << R"("/>
+    <camera name="tavt_truth" pos="0 0 0" xyaxes="1 0 0 0 0 1" fovy=")"
+    << fovy_deg << R"("/>
     <body name="tavt_rail" childclass="tavt">
-      <geom name="tavt_rail" type="box" size=")" << c.carriage_max_m + 0.05 << R"( 0.03 0.01" pos="0 0 -0.08"/>
+      <geom name="tavt_rail" type="box" size=")"
+    << c.carriage_max_m + 0.05 << R"( 0.03 0.01" pos="0 0 -0.08"/>
 )";
   for (const char* side : {"left", "right"}) {
     // Carriage: slide along X. Head: pan about Z, tilt about the panned X.
@@ -65,22 +68,25 @@ std::string RigMjcf(const SimRigConfig& c) {
     // geared microstepping stages. Damping makes each servo about critical.
     x << R"(      <body name="tavt_)" << side << R"(_carriage" pos="0 0 0">
         <inertial pos="0 0 0" mass="2" diaginertia="0.01 0.01 0.01"/>
-        <joint name="tavt_)" << side
-      << R"(_baseline" type="slide" axis="1 0 0" armature="3" damping="170"/>
+        <joint name="tavt_)"
+      << side << R"(_baseline" type="slide" axis="1 0 0" armature="3" damping="170"/>
         <geom type="box" size="0.04 0.05 0.01" pos="0 0 -0.065"/>
-        <body name="tavt_)" << side << R"(_pan" pos="0 0 0">
+        <body name="tavt_)"
+      << side << R"(_pan" pos="0 0 0">
           <inertial pos="0 0 0" mass="0.5" diaginertia="0.002 0.002 0.002"/>
-          <joint name="tavt_)" << side
-      << R"(_pan" type="hinge" axis="0 0 1" armature="0.02" damping="1.2"/>
+          <joint name="tavt_)"
+      << side << R"(_pan" type="hinge" axis="0 0 1" armature="0.02" damping="1.2"/>
           <geom type="cylinder" size="0.02 0.02" pos="0 0 -0.04"/>
-          <body name="tavt_)" << side << R"(_tilt" pos="0 0 0">
+          <body name="tavt_)"
+      << side << R"(_tilt" pos="0 0 0">
             <inertial pos="0 0 0" mass="0.4" diaginertia="0.001 0.001 0.001"/>
-            <joint name="tavt_)" << side
-      << R"(_tilt" type="hinge" axis="1 0 0" armature="0.01" damping="0.62"/>
-            <geom type="box" size="0.02 0.035 0.02" pos=")" << o.x() << " " << o.y() - 0.035
-      << " " << o.z() << R"("/>
-            <camera name="tavt_)" << side << R"(" pos=")" << o.x() << " " << o.y() << " "
-      << o.z() << R"(" xyaxes="1 0 0 0 0 1" fovy=")" << fovy_deg << R"("/>
+            <joint name="tavt_)"
+      << side << R"(_tilt" type="hinge" axis="1 0 0" armature="0.01" damping="0.62"/>
+            <geom type="box" size="0.02 0.035 0.02" pos=")"
+      << o.x() << " " << o.y() - 0.035 << " " << o.z() << R"("/>
+            <camera name="tavt_)"
+      << side << R"(" pos=")" << o.x() << " " << o.y() << " " << o.z()
+      << R"(" xyaxes="1 0 0 0 0 1" fovy=")" << fovy_deg << R"("/>
           </body>
         </body>
       </body>

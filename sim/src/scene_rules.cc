@@ -22,10 +22,18 @@ Box3 GeomBox(const mjModel* m, const mjData* d, int g) {
   Eigen::Vector3d half;
   switch (m->geom_type[g]) {
     case mjGEOM_BOX:
-    case mjGEOM_ELLIPSOID: half = {s[0], s[1], s[2]}; break;
-    case mjGEOM_SPHERE: half = {s[0], s[0], s[0]}; break;
-    case mjGEOM_CAPSULE: half = {s[0], s[0], s[1] + s[0]}; break;
-    case mjGEOM_CYLINDER: half = {s[0], s[0], s[1]}; break;
+    case mjGEOM_ELLIPSOID:
+      half = {s[0], s[1], s[2]};
+      break;
+    case mjGEOM_SPHERE:
+      half = {s[0], s[0], s[0]};
+      break;
+    case mjGEOM_CAPSULE:
+      half = {s[0], s[0], s[1] + s[0]};
+      break;
+    case mjGEOM_CYLINDER:
+      half = {s[0], s[0], s[1]};
+      break;
     default: {
       const double r = m->geom_rbound[g];
       const Eigen::Vector3d c(d->geom_xpos + 3 * g);
@@ -46,7 +54,8 @@ bool Overlap(const Box3& a, const Box3& b) {
 // A plane geom is infinite: it intrudes if any corner of the box lies behind it.
 bool PlaneCutsBox(const mjModel*, const mjData* d, int g, const Box3& box) {
   const Eigen::Vector3d p(d->geom_xpos + 3 * g);
-  const Eigen::Vector3d n(d->geom_xmat[9 * g + 2], d->geom_xmat[9 * g + 5], d->geom_xmat[9 * g + 8]);
+  const Eigen::Vector3d n(d->geom_xmat[9 * g + 2], d->geom_xmat[9 * g + 5],
+                          d->geom_xmat[9 * g + 8]);
   for (int i = 0; i < 8; ++i) {
     const Eigen::Vector3d corner((i & 1) ? box.max_W.x() : box.min_W.x(),
                                  (i & 2) ? box.max_W.y() : box.min_W.y(),
@@ -113,7 +122,8 @@ void CheckSceneRules(const World& w, const Box3& keep_out) {
     if (type == mjEQ_CONNECT || type == mjEQ_WELD)
       rig = (a >= 0 && m->body_rootid[a] == rail) || (b >= 0 && m->body_rootid[b] == rail);
     if (rig)
-      throw SceneError(where + " has an equality constraint on the rig (rule: scenes may not move "
+      throw SceneError(where +
+                       " has an equality constraint on the rig (rule: scenes may not move "
                        "the rig)");
   }
   // Rule 3: scene geometry stays out of the rig's workspace.

@@ -22,7 +22,8 @@ uint64_t SplitMix64(uint64_t x) {
 // Blur, then additive Gaussian noise, in place; `stream` selects an
 // independent, reproducible noise sequence.
 void ApplySensorModel(const NoiseConfig& noise, uint64_t stream, cv::Mat* image) {
-  if (noise.blur_sigma_px > 0) cv::GaussianBlur(*image, *image, cv::Size(0, 0), noise.blur_sigma_px);
+  if (noise.blur_sigma_px > 0)
+    cv::GaussianBlur(*image, *image, cv::Size(0, 0), noise.blur_sigma_px);
   if (noise.read_noise_sigma_dn > 0) {
     cv::RNG rng(SplitMix64(stream));
     cv::Mat n(image->size(), CV_32FC(image->channels()));

@@ -1,18 +1,17 @@
 #include "sim/simulation.h"
 
+#include <mujoco/mjxmacro.h>
+
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <regex>
 #include <set>
 #include <sstream>
-
-#include <mujoco/mjxmacro.h>
-
-#include <cmath>
-#include <filesystem>
 
 #include "sim/sim_rig.h"
 #include "world.h"
@@ -56,10 +55,11 @@ void AddToVfs(mjVFS* vfs, const std::string& name, const void* data, size_t size
 // name; mjOBJ_UNKNOWN for arrays not indexed by one element kind.
 int RowObject(const std::string& rows) {
   static const std::pair<const char*, int> kKinds[] = {
-      {"nbody", mjOBJ_BODY},     {"njnt", mjOBJ_JOINT},    {"ngeom", mjOBJ_GEOM},       {"nsite", mjOBJ_SITE},
-      {"ncam", mjOBJ_CAMERA},    {"nlight", mjOBJ_LIGHT},  {"nmesh", mjOBJ_MESH},       {"nmat", mjOBJ_MATERIAL},
-      {"ntex", mjOBJ_TEXTURE},   {"nu", mjOBJ_ACTUATOR},   {"nsensor", mjOBJ_SENSOR},   {"ntendon", mjOBJ_TENDON},
-      {"neq", mjOBJ_EQUALITY},   {"nhfield", mjOBJ_HFIELD}};
+      {"nbody", mjOBJ_BODY},   {"njnt", mjOBJ_JOINT},     {"ngeom", mjOBJ_GEOM},
+      {"nsite", mjOBJ_SITE},   {"ncam", mjOBJ_CAMERA},    {"nlight", mjOBJ_LIGHT},
+      {"nmesh", mjOBJ_MESH},   {"nmat", mjOBJ_MATERIAL},  {"ntex", mjOBJ_TEXTURE},
+      {"nu", mjOBJ_ACTUATOR},  {"nsensor", mjOBJ_SENSOR}, {"ntendon", mjOBJ_TENDON},
+      {"neq", mjOBJ_EQUALITY}, {"nhfield", mjOBJ_HFIELD}};
   for (const auto& [name, kind] : kKinds)
     if (rows == name) return kind;
   return mjOBJ_UNKNOWN;
@@ -81,21 +81,24 @@ long FirstNonFinite(const T* values, long n) {
 void CheckFinite(const mjModel* m, const std::string& where) {
   MJMODEL_POINTERS_PREAMBLE(m)
   (void)nq, (void)nv, (void)na, (void)nu, (void)nmocap;
-#define X(type, name, nr, nc)                                                                        \
-  if (const long at = FirstNonFinite(m->name, static_cast<long>(m->nr) * (nc)); at >= 0) {          \
-    const long row = at / (nc);                                                                     \
-    const int kind = RowObject(#nr);                                                                \
-    const char* element = kind == mjOBJ_UNKNOWN ? nullptr : mj_id2name(m, kind, static_cast<int>(row)); \
-    throw SceneError(where + ": " + (element ? std::string("'") + element + "'" : "element #" + std::to_string(row)) + \
-                     " has a non-finite number (NaN or infinity) in " #name);                        \
+#define X(type, name, nr, nc)                                                              \
+  if (const long at = FirstNonFinite(m->name, static_cast<long>(m->nr) * (nc)); at >= 0) { \
+    const long row = at / (nc);                                                            \
+    const int kind = RowObject(#nr);                                                       \
+    const char* element =                                                                  \
+        kind == mjOBJ_UNKNOWN ? nullptr : mj_id2name(m, kind, static_cast<int>(row));      \
+    throw SceneError(                                                                      \
+        where + ": " +                                                                     \
+        (element ? std::string("'") + element + "'" : "element #" + std::to_string(row)) + \
+        " has a non-finite number (NaN or infinity) in " #name);                           \
   }
   MJMODEL_POINTERS
 #undef X
 }
 
-const char* const kAxisNames[rig::kNumAxes] = {"tavt_left_baseline",  "tavt_left_pan",
-                                               "tavt_left_tilt",      "tavt_right_baseline",
-                                               "tavt_right_pan",      "tavt_right_tilt"};
+const char* const kAxisNames[rig::kNumAxes] = {"tavt_left_baseline", "tavt_left_pan",
+                                               "tavt_left_tilt",     "tavt_right_baseline",
+                                               "tavt_right_pan",     "tavt_right_tilt"};
 
 }  // namespace
 
@@ -126,8 +129,9 @@ namespace {
 
 // The scene compiled with the rig, its numbers finite and its rules kept:
 // everything of a load but the renderer. Throws SceneError.
-std::unique_ptr<World> CompileWorld(const std::string& scene_path, const std::string& xml, bool from_memory,
-                                    const SimRigConfig& config, const AssetProvider& assets) {
+std::unique_ptr<World> CompileWorld(const std::string& scene_path, const std::string& xml,
+                                    bool from_memory, const SimRigConfig& config,
+                                    const AssetProvider& assets) {
   mju_user_error = MujocoError;
   const std::string shown = rig::ClipForMessage(scene_path);
   if (xml.find("<mujoco") == std::string::npos)
@@ -149,7 +153,8 @@ std::unique_ptr<World> CompileWorld(const std::string& scene_path, const std::st
   static const std::regex kFileAttr(R"(file\s*=\s*"([^"]+)\")");
   std::set<std::string> seen;
   const std::filesystem::path scene_dir = std::filesystem::path(scene_path).parent_path();
-  for (auto it = std::sregex_iterator(xml.begin(), xml.end(), kFileAttr); it != std::sregex_iterator(); ++it) {
+  for (auto it = std::sregex_iterator(xml.begin(), xml.end(), kFileAttr);
+       it != std::sregex_iterator(); ++it) {
     const std::string file = (*it)[1].str(), name = BaseName(file);
     if (name == kRigIncludeName || !seen.insert(file).second) continue;
     if (assets)
@@ -193,7 +198,8 @@ std::unique_ptr<World> CompileWorld(const std::string& scene_path, const std::st
                        kRigIncludeName + "\"/>): joint '" + kAxisNames[i] + "' is missing");
     }
   }
-  w.camera_ids = {mj_name2id(m, mjOBJ_CAMERA, "tavt_left"), mj_name2id(m, mjOBJ_CAMERA, "tavt_right")};
+  w.camera_ids = {mj_name2id(m, mjOBJ_CAMERA, "tavt_left"),
+                  mj_name2id(m, mjOBJ_CAMERA, "tavt_right")};
   w.truth_camera_id = mj_name2id(m, mjOBJ_CAMERA, "tavt_truth");
   // Depth resolution: near and far planes for a 0.05 to 30 m working range.
   m->vis.map.znear = static_cast<float>(0.05 / m->stat.extent);
@@ -207,14 +213,15 @@ std::unique_ptr<World> CompileWorld(const std::string& scene_path, const std::st
 
 }  // namespace
 
-void Simulation::CheckScene(const std::string& name, const std::string& xml, const SimRigConfig& config,
-                            const AssetProvider& assets) {
+void Simulation::CheckScene(const std::string& name, const std::string& xml,
+                            const SimRigConfig& config, const AssetProvider& assets) {
   config.Check();
   CompileWorld(name, xml, /*from_memory=*/true, config, assets);
 }
 
-std::unique_ptr<Simulation> Simulation::LoadImpl(const std::string& scene_path, const std::string& xml,
-                                                 bool from_memory, const SimRigConfig& config,
+std::unique_ptr<Simulation> Simulation::LoadImpl(const std::string& scene_path,
+                                                 const std::string& xml, bool from_memory,
+                                                 const SimRigConfig& config,
                                                  const AssetProvider& assets) {
   std::unique_ptr<Simulation> sim(new Simulation());
   sim->world_ = CompileWorld(scene_path, xml, from_memory, config, assets);

@@ -47,8 +47,8 @@ struct World {
   std::array<int, rig::kNumAxes> actuator_ids{};  // ordered as rig::Axis
   std::array<int, 2> camera_ids{};                // left, right
   int truth_camera_id = -1;
-  std::vector<unsigned char> visible_groups;      // mj_ray filter: groups 0-2
-  OffscreenRenderer* renderer = nullptr;           // owned
+  std::vector<unsigned char> visible_groups;  // mj_ray filter: groups 0-2
+  OffscreenRenderer* renderer = nullptr;      // owned
 
   ~World();
 };

@@ -17,7 +17,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   }
   for (const std::string& reply : {bytes, d.position_reply + bytes, d.status_reply + bytes}) {
     if (const auto steps = d.ParsePosition(reply)) {
-      const std::string again = d.position_reply + (*steps >= 0 ? "+" : "") + std::to_string(*steps);
+      const std::string again =
+          d.position_reply + (*steps >= 0 ? "+" : "") + std::to_string(*steps);
       if (d.ParsePosition(again) != steps) std::abort();
     }
     if (const auto bits = d.ParseStatus(reply))

@@ -17,7 +17,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   } catch (const rig::InputError&) {
     return 0;
   }
-  if (sweep.runs.empty() || static_cast<long>(sweep.runs.size()) > experiments::kMaxSweepRuns) std::abort();
+  if (sweep.runs.empty() || static_cast<long>(sweep.runs.size()) > experiments::kMaxSweepRuns)
+    std::abort();
   std::set<std::string> ids;
   for (const experiments::SweepRun& run : sweep.runs)
     if (!ids.insert(run.id).second || run.id != experiments::ConfigHash(run.config)) std::abort();

@@ -27,12 +27,13 @@ struct CriteriaOptions {
   bool proximity_2d = true;
   bool proximity_3d = true;
   double gradient_blur_px = 2.0;
-  double suppressed_weight = 0.02;  ///< local suppression's weight on foveal data
+  double suppressed_weight = 0.02;     ///< local suppression's weight on foveal data
   double suppression_radius_m = 0.08;  ///< and within this distance of an earlier fixation
-  double peripheral_weight = 0.3;   ///< local suppression's weight on peripheral data (paper: 1)
-  double revisit_radius_m = 0.03;   ///< local suppression's weight is 0 this close to an earlier fixation
+  double peripheral_weight = 0.3;      ///< local suppression's weight on peripheral data (paper: 1)
+  double revisit_radius_m =
+      0.03;  ///< local suppression's weight is 0 this close to an earlier fixation
   double proximity_2d_scale_px = 320;
-  double proximity_3d_low = 0.1;    ///< 3D proximity's weight outside the Z_T band
+  double proximity_3d_low = 0.1;  ///< 3D proximity's weight outside the Z_T band
   void Check() const;
   std::vector<std::shared_ptr<const FixationCriterion>> Make() const;
 };
@@ -43,7 +44,7 @@ struct FoveaOptions {
   SelectionOptions selection;
   CriteriaOptions criteria;
   IntegrationOptions integration;
-  int fixations = 25;          ///< successful fixations to make
+  int fixations = 25;  ///< successful fixations to make
   /// Fixate only points inside the IDR view: the region the run maps.
   bool stay_in_idr_view = true;
   /// Beyond the paper: pixels the map is silent at are fixation candidates
@@ -61,8 +62,8 @@ struct FoveaOptions {
   /// Attempts allowed per fixation wanted, so that a run of refused points
   /// always ends.
   int attempts_per_fixation = 3;
-  uint64_t seed = 0;           ///< the one generator's seed
-  void Check() const;          ///< throws std::invalid_argument naming the field
+  uint64_t seed = 0;   ///< the one generator's seed
+  void Check() const;  ///< throws std::invalid_argument naming the field
 };
 
 /// Wall-clock seconds by stage of one fixation.
@@ -73,11 +74,11 @@ struct StageTimes {
 
 /// Everything one attempt did, for the records.
 struct FixationRecord {
-  int attempt = 0;                 ///< 1-based
-  int fixation = 0;                ///< 1-based index among successful ones (0 if refused)
+  int attempt = 0;   ///< 1-based
+  int fixation = 0;  ///< 1-based index among successful ones (0 if refused)
   bool ok = false;
-  std::string why;                 ///< when refused
-  SelectionSummary selection;      ///< how the target was chosen (first one: from IDR)
+  std::string why;             ///< when refused
+  SelectionSummary selection;  ///< how the target was chosen (first one: from IDR)
   Eigen::Vector3d target_W = Eigen::Vector3d::Zero();
   Eigen::Vector3d fixation_W = Eigen::Vector3d::Zero();
   rig::StageState state;
@@ -85,11 +86,11 @@ struct FixationRecord {
   int servo_iterations = 0;
   double servo_residual_px = 0;
   bool servo_converged = false;
-  Tessellation tessellation;       ///< without its images (cleared)
+  Tessellation tessellation;  ///< without its images (cleared)
   std::vector<LevelFigures> levels;
   IntegrationStats integration;
   std::array<int, 3> map_by_level{0, 0, 0};
-  double foveal_share = 0;         ///< map's foveal share of the IDR view, as the loop sees it
+  double foveal_share = 0;  ///< map's foveal share of the IDR view, as the loop sees it
   double motion_time_s = 0;
   StageTimes time;
 };
@@ -100,7 +101,7 @@ struct FoveaRun {
   std::vector<FixationRecord> records;
   int fixations_done = 0;
   std::string stop_reason;
-  double motion_time_s = 0;        ///< IDR's and every fixation's
+  double motion_time_s = 0;  ///< IDR's and every fixation's
   double compute_time_s = 0;
 };
 

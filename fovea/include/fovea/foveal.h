@@ -20,13 +20,13 @@ namespace fovea {
 
 struct FovealOptions {
   TessellationOptions tessellation;
-  int fovea_patch_px = 8;       ///< patch size at level 0, in its pixels
+  int fovea_patch_px = 8;  ///< patch size at level 0, in its pixels
   /// Patch size at coarser levels in full-resolution pixels: level k uses
   /// blocks of max(4, periphery_patch_px / 2^k) of its pixels.
   int periphery_patch_px = 32;
   PlaneFitOptions plane_fit{/*min_support=*/12, /*fit_tolerance_px=*/1.0, /*min_inlier_share=*/0.8,
                             /*require_quadrants=*/true};
-  double map_margin_px = 2.0;   ///< search +- this many level pixels around the map's prediction
+  double map_margin_px = 2.0;     ///< search +- this many level pixels around the map's prediction
   double coarse_margin_px = 1.5;  ///< and around the coarser level's estimate
   /// Where the map is silent and no coarser estimate exists, the paper
   /// searches the Z_T band about the fixation depth, which takes a false
@@ -44,9 +44,10 @@ struct FovealOptions {
 /// Figures of one resolution level.
 struct LevelFigures {
   int level = 0;
-  cv::Rect rect;            ///< full-resolution pixels the level covers
+  cv::Rect rect;  ///< full-resolution pixels the level covers
   int searched = 0, matched = 0, patches = 0;
-  int outside_band = 0;     ///< band matches dropped: the wider search matched outside (FovealOptions::silent_near_m)
+  int outside_band =
+      0;  ///< band matches dropped: the wider search matched outside (FovealOptions::silent_near_m)
   double match_time_s = 0;
 };
 
@@ -54,7 +55,7 @@ struct FovealResult {
   Tessellation tessellation;
   std::vector<cv::Mat> disparity_px;  ///< per level, at its resolution (NaN = none)
   std::vector<LevelFigures> levels;
-  PatchMap patches;                   ///< foveal (level 0) and peripheral patches
+  PatchMap patches;  ///< foveal (level 0) and peripheral patches
   double compute_time_s = 0;
 };
 
@@ -91,10 +92,11 @@ struct FixationOptions {
 struct FixationResult {
   bool ok = false;
   Placement placement = Placement::kSymmetric;
-  std::string why;                   ///< when not ok: why the point could not be fixated
+  std::string why;  ///< when not ok: why the point could not be fixated
   VergenceSolution vergence;
   ServoResult servo;
-  Eigen::Vector3d fixation_W = Eigen::Vector3d::Zero();  ///< where the optical axes meet after servoing
+  Eigen::Vector3d fixation_W =
+      Eigen::Vector3d::Zero();  ///< where the optical axes meet after servoing
   FovealResult foveal;
   double motion_time_s = 0, compute_time_s = 0;
   double verge_time_s = 0;  ///< inverse kinematics
@@ -107,7 +109,8 @@ struct FixationResult {
 /// converge leaves the point not fixable (the foveated stage would search
 /// around a depth nobody measured).
 FixationResult Fixate(rig::Rig& rig, const PatchMap& map, const Eigen::Vector3d& p_W,
-                      const StereoMatcher& matcher, const FixationOptions& options, int fixation = 0,
+                      const StereoMatcher& matcher, const FixationOptions& options,
+                      int fixation = 0,
                       const std::optional<DepthRange>& guessed_depths = std::nullopt);
 
 }  // namespace fovea

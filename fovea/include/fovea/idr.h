@@ -41,12 +41,12 @@ struct ZcMatchOptions {
 /// Figures of one matching pass (counts of left crossings unless named).
 struct ZcMatchStats {
   int left_crossings = 0, right_crossings = 0;
-  int searched = 0;         ///< left crossings with a search window
-  int no_candidate = 0;     ///< window held no compatible crossing
-  int ambiguous = 0;        ///< window held more than one
-  int unique = 0;           ///< exactly one
-  int inconsistent = 0;     ///< unique left-to-right but not confirmed right-to-left
-  int matches = 0;          ///< consistent both ways
+  int searched = 0;      ///< left crossings with a search window
+  int no_candidate = 0;  ///< window held no compatible crossing
+  int ambiguous = 0;     ///< window held more than one
+  int unique = 0;        ///< exactly one
+  int inconsistent = 0;  ///< unique left-to-right but not confirmed right-to-left
+  int matches = 0;       ///< consistent both ways
   /// Share of crossings with candidates whose window held exactly one.
   double UnambiguousShare() const;
 };
@@ -62,7 +62,8 @@ struct ZcMatch {
 /// polarity, orientation within tolerance, disparity inside the window),
 /// left-to-right and right-to-left; only unique matches that agree both ways
 /// are kept (paper section II-A, occlusion).
-std::vector<ZcMatch> MatchZeroCrossings(const ZeroCrossingImage& left, const ZeroCrossingImage& right,
+std::vector<ZcMatch> MatchZeroCrossings(const ZeroCrossingImage& left,
+                                        const ZeroCrossingImage& right,
                                         const DisparityWindows& left_windows,
                                         const DisparityWindows& right_windows,
                                         const ZcMatchOptions& options, ZcMatchStats* stats);
@@ -89,19 +90,19 @@ double ExpansionFactor(double s_min_px, double d_max_px, double focal_px, double
 struct IdrOptions {
   ZeroCrossingOptions zero_crossings;
   ZcMatchOptions matching;
-  double unique_share = 0.90;       ///< share of crossings kept unambiguous at B0
-  double z_min_m = 0.40;            ///< nearest surface
-  double max_slant_deg = 60;        ///< for the expansion factor
-  double max_expansion = 4.0;       ///< cap on k per stage
-  double min_expansion = 1.1;       ///< below this, expanding is not worth a stage
-  double vergent_search_px = 4;     ///< P: the vergent stage searches +-P px
+  double unique_share = 0.90;    ///< share of crossings kept unambiguous at B0
+  double z_min_m = 0.40;         ///< nearest surface
+  double max_slant_deg = 60;     ///< for the expansion factor
+  double max_expansion = 4.0;    ///< cap on k per stage
+  double min_expansion = 1.1;    ///< below this, expanding is not worth a stage
+  double vergent_search_px = 4;  ///< P: the vergent stage searches +-P px
   /// Baseline of the vergent stage, for the termination rule. Deliberately
   /// not tied to foveal.baseline_m (0.06): with 0.06 IDR stops at a 0.012 m
   /// baseline instead of 0.048 m, and the coarser map cost fovea run
   /// coverage (two_planes 0.995 -> 0.949, three_surfaces 0.947 -> 0.927,
   /// seed 0) and two_planes' near-then-far order.
   double vergent_baseline_m = 0.12;
-  int max_stages = 6;               ///< budget: IDR always ends
+  int max_stages = 6;  ///< budget: IDR always ends
   int patch_size_px = 16;
   PlaneFitOptions plane_fit;
   /// Matches with a neighbour within 2 sigma whose disparity differs by more
@@ -117,10 +118,10 @@ struct IdrOptions {
 /// Figures of one baseline stage, for the experiment harness.
 struct IdrStage {
   double baseline_m = 0;
-  double search_limit_px = 0;     ///< d_max searched (stage 0) or widest window (later)
-  double expansion_factor = 1;    ///< applied after this stage (1 at the last)
-  double min_separation_px = 0;   ///< s_min at this stage
-  double max_disparity_px = 0;    ///< largest matched disparity
+  double search_limit_px = 0;    ///< d_max searched (stage 0) or widest window (later)
+  double expansion_factor = 1;   ///< applied after this stage (1 at the last)
+  double min_separation_px = 0;  ///< s_min at this stage
+  double max_disparity_px = 0;   ///< largest matched disparity
   ZcMatchStats stats;
   double motion_time_s = 0;
   double compute_time_s = 0;
@@ -129,10 +130,10 @@ struct IdrStage {
 struct IdrResult {
   std::vector<IdrStage> stages;
   std::string stop_reason;
-  rig::StereoFrame final_frame;              ///< the pair the patches come from
-  std::vector<DisparitySample> final_samples;  ///< matched crossings at the final baseline
+  rig::StereoFrame final_frame;                  ///< the pair the patches come from
+  std::vector<DisparitySample> final_samples;    ///< matched crossings at the final baseline
   std::vector<Eigen::Vector2d> final_unmatched;  ///< searched crossings left unmatched
-  PatchMap map;                              ///< IDR patches
+  PatchMap map;                                  ///< IDR patches
   bool has_fixation = false;
   Eigen::Vector3d first_fixation_W = Eigen::Vector3d::Zero();
   int first_fixation_patch = -1;
@@ -149,8 +150,7 @@ IdrResult RunIdr(rig::Rig& rig, const IdrOptions& options);
 /// its inliers' extent (so that it never reaches over a depth step where the
 /// features stop short of the edge); corners back-projected with Z = f B / d.
 PatchMap PatchesFromDisparities(const std::vector<DisparitySample>& samples,
-                                const rig::CameraView& left, double baseline_m,
-                                int patch_size_px, const PlaneFitOptions& options,
-                                PatchLevel level);
+                                const rig::CameraView& left, double baseline_m, int patch_size_px,
+                                const PlaneFitOptions& options, PatchLevel level);
 
 }  // namespace fovea

@@ -18,10 +18,10 @@ struct IntegrationOptions {
 };
 
 struct IntegrationStats {
-  int offered = 0;             ///< new patches
-  int added = 0;               ///< kept and added to the map
-  int dropped_under_finer = 0; ///< new patches dropped because finer data covers them
-  int added_outside_view = 0;  ///< new patches with no footprint in the view (added as they are)
+  int offered = 0;              ///< new patches
+  int added = 0;                ///< kept and added to the map
+  int dropped_under_finer = 0;  ///< new patches dropped because finer data covers them
+  int added_outside_view = 0;   ///< new patches with no footprint in the view (added as they are)
   std::array<int, 3> replaced{0, 0, 0};  ///< old patches removed, by their PatchLevel
 };
 

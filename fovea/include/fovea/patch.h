@@ -21,10 +21,10 @@ const char* PatchLevelName(PatchLevel level);
 struct Patch {
   std::array<Eigen::Vector3d, 4> corners_W;  ///< in order around the quad
   PatchLevel level = PatchLevel::kIdr;
-  int fixation = -1;          ///< index of the fixation that made it; -1 for IDR
-  int resolution_level = 0;   ///< 0 = full resolution, k = downsampled 2^k
-  double fit_rms_px = 0;      ///< RMS residual of its disparity-plane fit
-  int support = 0;            ///< number of measurements in the fit
+  int fixation = -1;         ///< index of the fixation that made it; -1 for IDR
+  int resolution_level = 0;  ///< 0 = full resolution, k = downsampled 2^k
+  double fit_rms_px = 0;     ///< RMS residual of its disparity-plane fit
+  int support = 0;           ///< number of measurements in the fit
 
   /// Order of precedence between patches of the same surface: foveal over
   /// peripheral over IDR, and within a level the finer resolution first.
@@ -46,7 +46,7 @@ struct PlaneFit {
 };
 
 struct PlaneFitOptions {
-  int min_support = 8;           ///< inlier measurements needed in a block
+  int min_support = 8;  ///< inlier measurements needed in a block
   /// Measurements farther than this from the plane are outliers; the fit is
   /// redone without them (twice), and every kept measurement lies within it.
   double fit_tolerance_px = 1.0;
@@ -105,7 +105,8 @@ class PatchMap {
   std::array<int, 3> CountByLevel() const;
 
   /// First patch hit by the ray from origin_W along direction_W (unit).
-  std::optional<PatchHit> CastRay(const Eigen::Vector3d& origin_W, const Eigen::Vector3d& direction_W) const;
+  std::optional<PatchHit> CastRay(const Eigen::Vector3d& origin_W,
+                                  const Eigen::Vector3d& direction_W) const;
   /// The same query by testing every patch: the reference for the index.
   std::optional<PatchHit> CastRayBruteForce(const Eigen::Vector3d& origin_W,
                                             const Eigen::Vector3d& direction_W) const;

@@ -17,9 +17,10 @@ namespace fovea {
 
 /// Where the two carriages sit for a vergent baseline b.
 enum class Placement {
-  kSymmetric,    ///< +-b/2 about the rail centre
-  kRightInner,   ///< right carriage innermost, the left one b to its left
-  kLeftInner,    ///< left carriage innermost (where IDR's left camera sits), the right one b to its right
+  kSymmetric,   ///< +-b/2 about the rail centre
+  kRightInner,  ///< right carriage innermost, the left one b to its left
+  kLeftInner,   ///< left carriage innermost (where IDR's left camera sits), the right one b to its
+                ///< right
   /// The left camera alone at two positions (rig::LeftCameraPair): its
   /// "right" stage at the home pose's left carriage, its left stage b
   /// further left. Sees past nearer surfaces' left edges what the home
@@ -70,8 +71,9 @@ struct PlacementChoice {
 /// p_W. Last, if `rig.left_pair`, the left camera pair (kLeftPair), which
 /// costs twice the moves. Cost: 4 vergences and up to 56 ray casts, each
 /// O(log patches).
-PlacementChoice ChoosePlacement(const PlacementRig& rig, const PatchMap& map, const Eigen::Vector3d& p_W,
-                                double baseline_m,
-                                const VergenceOptions& vergence, const std::optional<DepthRange>& guessed_depths);
+PlacementChoice ChoosePlacement(const PlacementRig& rig, const PatchMap& map,
+                                const Eigen::Vector3d& p_W, double baseline_m,
+                                const VergenceOptions& vergence,
+                                const std::optional<DepthRange>& guessed_depths);
 
 }  // namespace fovea

@@ -7,8 +7,8 @@
 
 #include <Eigen/Core>
 #include <memory>
-#include <optional>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -20,17 +20,18 @@ namespace fovea {
 
 /// What the criteria may look at.
 struct SelectionContext {
-  cv::Mat image;                ///< current left view, CV_8UC1
-  rig::CameraView view;         ///< its camera
+  cv::Mat image;         ///< current left view, CV_8UC1
+  rig::CameraView view;  ///< its camera
   /// The map rendered into the view (CV_32F, 0 = none). With hole filling,
   /// pixels the map is silent at carry the depth of the nearest mapped pixel
   /// (map_level stays -1 there).
   cv::Mat map_depth_m;
-  cv::Mat map_level;            ///< CV_8S: PatchLevel of the patch seen, -1 = none
-  bool has_fixation = false;    ///< false before the first vergent fixation
-  double fixation_depth_m = 0;  ///< depth of the current fixation point in the view
+  cv::Mat map_level;                     ///< CV_8S: PatchLevel of the patch seen, -1 = none
+  bool has_fixation = false;             ///< false before the first vergent fixation
+  double fixation_depth_m = 0;           ///< depth of the current fixation point in the view
   double z_t_near_m = 0, z_t_far_m = 0;  ///< the current fovea's depth band (Z_T)
-  std::vector<Eigen::Vector3d> fixated_W;  ///< earlier fixation points (and holes' guessed points aimed at)
+  std::vector<Eigen::Vector3d>
+      fixated_W;  ///< earlier fixation points (and holes' guessed points aimed at)
   /// If set, only points that this view sees (the IDR view: the region the
   /// run maps) are candidates.
   std::optional<rig::CameraView> region;
@@ -42,8 +43,8 @@ struct SelectionContext {
   /// `fill_holes`, pixels the map is silent at take the depth of the nearest
   /// pixel it shows (Euclidean distance in the image), so that the unmapped
   /// parts of the view can be fixated: the servo then finds their depth.
-  static SelectionContext Make(const cv::Mat& image, const rig::CameraView& view, const PatchMap& map,
-                               bool fill_holes = false);
+  static SelectionContext Make(const cv::Mat& image, const rig::CameraView& view,
+                               const PatchMap& map, bool fill_holes = false);
 };
 
 /// One criterion: a non-negative weight per pixel (CV_64F, the view's size)
@@ -82,7 +83,10 @@ class LocalSuppression : public FixationCriterion {
  public:
   explicit LocalSuppression(double suppressed_weight = 0.02, double radius_m = 0.04,
                             double peripheral_weight = 1.0, double revisit_radius_m = 0)
-      : low_(suppressed_weight), radius_(radius_m), peripheral_(peripheral_weight), revisit_(revisit_radius_m) {}
+      : low_(suppressed_weight),
+        radius_(radius_m),
+        peripheral_(peripheral_weight),
+        revisit_(revisit_radius_m) {}
   std::string Name() const override { return "suppression"; }
   cv::Mat Evaluate(const SelectionContext& context) const override;
 
@@ -120,7 +124,7 @@ struct SelectionOptions {
   bool deterministic = false;  ///< always take the maximum of the composite
   double draw_scale = 0.5;     ///< s of the exponential draw
   int histogram_bins = 64;
-  int border_px = 16;          ///< candidates keep this far from the image edge
+  int border_px = 16;  ///< candidates keep this far from the image edge
   /// Candidates whose map point lies within this distance of a point that
   /// could not be fixated are left out.
   double refused_radius_m = 0.03;
@@ -130,13 +134,13 @@ struct SelectionOptions {
 /// What one choice looked like, for the records.
 struct SelectionSummary {
   bool ok = false;
-  std::string why;                  ///< when not ok
+  std::string why;  ///< when not ok
   Eigen::Vector2d pixel = Eigen::Vector2d::Zero();
   Eigen::Vector3d point_W = Eigen::Vector3d::Zero();
-  bool in_hole = false;             ///< the pixel showed no map data: point_W is a guess
-  int candidates = 0;               ///< pixels with a map point
+  bool in_hole = false;  ///< the pixel showed no map data: point_W is a guess
+  int candidates = 0;    ///< pixels with a map point
   double composite_max = 0, composite_chosen = 0;
-  double drawn_value = 0;           ///< c drawn from the exponential density
+  double drawn_value = 0;  ///< c drawn from the exponential density
   int bin = -1;
   /// Per criterion: its name, its value at the chosen pixel relative to its
   /// mean over the candidates (1 = average, > 1 = favoured).
@@ -160,9 +164,12 @@ class FixationSelector {
 
   /// Draws the next fixation point.
   SelectionSummary Choose(const SelectionContext& context, const PatchMap& map,
-                          const std::vector<Eigen::Vector3d>& refused_W, std::mt19937_64* rng) const;
+                          const std::vector<Eigen::Vector3d>& refused_W,
+                          std::mt19937_64* rng) const;
 
-  const std::vector<std::shared_ptr<const FixationCriterion>>& criteria() const { return criteria_; }
+  const std::vector<std::shared_ptr<const FixationCriterion>>& criteria() const {
+    return criteria_;
+  }
 
  private:
   std::vector<std::shared_ptr<const FixationCriterion>> criteria_;

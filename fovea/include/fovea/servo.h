@@ -14,16 +14,17 @@ namespace fovea {
 /// Normalized L1 cost of two (2 half + 1)^2 windows centred at integer
 /// pixels: mean over the window of |(L - mean L) - (R - mean R)|, grey
 /// levels. Windows must lie inside their images.
-double NormalizedL1(const cv::Mat& left, int xl, int yl, const cv::Mat& right, int xr, int yr, int half);
+double NormalizedL1(const cv::Mat& left, int xl, int yl, const cv::Mat& right, int xr, int yr,
+                    int half);
 
 struct ServoOptions {
-  int window_half_px = 15;     ///< a 31 x 31 window
-  int search_px = 40;          ///< first measurement: horizontal search +- this many pixels
+  int window_half_px = 15;  ///< a 31 x 31 window
+  int search_px = 40;       ///< first measurement: horizontal search +- this many pixels
   /// Later measurements, after a move that nulled the last one d: +- the
   /// larger of this and |d| / 4 (a move is good to a few per cent).
   int refine_px = 8;
-  double tolerance_px = 0.5;   ///< done when the residual disparity is below this
-  int max_steps = 6;           ///< step budget
+  double tolerance_px = 0.5;  ///< done when the residual disparity is below this
+  int max_steps = 6;          ///< step budget
   /// A search over a depth range (see Servo) keeps its best match only if
   /// its cost is below this share of the best match elsewhere (a repeated
   /// texture's other copies): 1 keeps any minimum.

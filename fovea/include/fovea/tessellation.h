@@ -49,7 +49,8 @@ cv::Mat VerticalDisparity(const rig::CameraView& left, const rig::CameraView& ri
 
 /// Horizontal disparity (u_right - cx_right) of the point on the left
 /// optical axis at depth z_m.
-double AxisHorizontalDisparity(const rig::CameraView& left, const rig::CameraView& right, double z_m);
+double AxisHorizontalDisparity(const rig::CameraView& left, const rig::CameraView& right,
+                               double z_m);
 
 /// Builds the tessellation for a verged pair fixating p_W, using the map's
 /// depths in the left view for Z_max and the mask.

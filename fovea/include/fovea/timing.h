@@ -9,6 +9,8 @@ namespace fovea {
 using Clock = std::chrono::steady_clock;
 
 /// Seconds elapsed since `t0`.
-inline double Since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+inline double Since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
 
 }  // namespace fovea

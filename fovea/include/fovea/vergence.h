@@ -10,18 +10,18 @@
 namespace fovea {
 
 struct VergenceOptions {
-  int max_iterations = 30;        ///< Newton steps per camera
-  double tolerance_px = 0.01;     ///< the point must project this close to the principal point
-  double min_distance_m = 0.2;    ///< nearer points are not fixable
+  int max_iterations = 30;      ///< Newton steps per camera
+  double tolerance_px = 0.01;   ///< the point must project this close to the principal point
+  double min_distance_m = 0.2;  ///< nearer points are not fixable
   void Check() const;
 };
 
 /// Stage state that fixates a point, or why it cannot be fixated.
 struct VergenceSolution {
   bool ok = false;
-  rig::StageState state;        ///< quantized to motor steps; baselines as given
+  rig::StageState state;           ///< quantized to motor steps; baselines as given
   double residual_px[2] = {0, 0};  ///< distance of the point's projection from each principal point
-  std::string why;              ///< empty when ok
+  std::string why;                 ///< empty when ok
 };
 
 /// Pan and tilt of each camera (carriages kept where `baselines` has them)

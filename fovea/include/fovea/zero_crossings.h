@@ -23,19 +23,20 @@ struct ZeroCrossingOptions {
 
 /// One zero crossing between pixels (x, y) and (x + 1, y).
 struct ZeroCrossing {
-  float x_px;         ///< sub-pixel column where the LoG crosses zero
-  int y_px;           ///< row
-  signed char polarity;  ///< +1 where the LoG rises left to right, -1 where it falls
+  float x_px;             ///< sub-pixel column where the LoG crosses zero
+  int y_px;               ///< row
+  signed char polarity;   ///< +1 where the LoG rises left to right, -1 where it falls
   float orientation_rad;  ///< direction of the LoG gradient, atan2(gy, gx), in (-pi, pi]
-  float slope;        ///< |LoG(x + 1) - LoG(x)|
+  float slope;            ///< |LoG(x + 1) - LoG(x)|
 };
 
 /// Zero crossings of one image, sorted by row then column, with an index of
 /// where each row's crossings start.
 struct ZeroCrossingImage {
   std::vector<ZeroCrossing> crossings;
-  std::vector<int> row_begin;  ///< size rows + 1: row y's crossings are [row_begin[y], row_begin[y+1])
-  cv::Mat log;                 ///< the normalized LoG response, CV_32F
+  std::vector<int>
+      row_begin;  ///< size rows + 1: row y's crossings are [row_begin[y], row_begin[y+1])
+  cv::Mat log;    ///< the normalized LoG response, CV_32F
 
   int rows() const { return static_cast<int>(row_begin.size()) - 1; }
 };

@@ -19,7 +19,8 @@ namespace rig {
 class CameraSource {
  public:
   /// Throws RigError naming the source when it cannot be opened.
-  CameraSource(const std::string& spec, int width_px, int height_px, std::chrono::milliseconds timeout);
+  CameraSource(const std::string& spec, int width_px, int height_px,
+               std::chrono::milliseconds timeout);
   /// The next frame, CV_8UC1. Throws RigError when none comes within the
   /// timeout (the source is then given up), when the source has ended, or
   /// when its size is not the calibrated one.

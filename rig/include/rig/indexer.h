@@ -35,13 +35,13 @@ enum class IndexerCommand {
 struct IndexerDialect {
   std::string name;
   std::array<std::string, static_cast<int>(IndexerCommand::kCount)> templates;
-  std::string line_end = "\r";     ///< ends every command
-  std::string ok_prompt = "> ";    ///< after a good command (error level 4), at a line start
-  std::string error_prompt = "? "; ///< after a rejected one, its error text before
-  std::string position_reply = "*TPC";  ///< followed by a signed step count
-  std::string status_reply = "*TAS";    ///< followed by 32 bits in groups of 4
-  int moving_bit = 0;       ///< bit numbers (0 = first character) in the status
-  int fault_bit = 13;       ///< drive fault
+  std::string line_end = "\r";           ///< ends every command
+  std::string ok_prompt = "> ";          ///< after a good command (error level 4), at a line start
+  std::string error_prompt = "? ";       ///< after a rejected one, its error text before
+  std::string position_reply = "*TPC";   ///< followed by a signed step count
+  std::string status_reply = "*TAS";     ///< followed by 32 bits in groups of 4
+  int moving_bit = 0;                    ///< bit numbers (0 = first character) in the status
+  int fault_bit = 13;                    ///< drive fault
   int limit_bits[4] = {14, 15, 16, 17};  ///< hardware and soft limits hit
 
   std::string Format(IndexerCommand command, int unit, const std::string& value = "") const;
@@ -89,21 +89,21 @@ std::unique_ptr<SerialLine> OpenSerialPort(const std::string& port, int baud);
 /// One axis: its unit address and how its steps relate to metres or radians.
 struct IndexerAxis {
   int unit = 1;
-  double steps_per_unit = 1;   ///< steps per metre or per radian
-  int sign = 1;                ///< +1 or -1: motor direction against the axis
-  double velocity = 1;         ///< metres or radians per second
-  double acceleration = 1;     ///< per second squared
-  double min = 0, max = 0;     ///< soft limits, metres or radians
+  double steps_per_unit = 1;  ///< steps per metre or per radian
+  int sign = 1;               ///< +1 or -1: motor direction against the axis
+  double velocity = 1;        ///< metres or radians per second
+  double acceleration = 1;    ///< per second squared
+  double min = 0, max = 0;    ///< soft limits, metres or radians
 };
 
 struct IndexerOptions {
   std::array<IndexerAxis, kNumAxes> axes;  ///< in Axis order
   std::chrono::milliseconds reply_timeout{1000};
-  int retries = 1;                    ///< resend once on a timeout (waiting a quarter as long), then fail
-  double move_timeout_margin_s = 2;   ///< a move may take its profile time x2 plus this
+  int retries = 1;  ///< resend once on a timeout (waiting a quarter as long), then fail
+  double move_timeout_margin_s = 2;  ///< a move may take its profile time x2 plus this
   std::chrono::milliseconds poll_interval{20};
-  int position_tolerance_steps = 0;   ///< read-back against command
-  void Check() const;                 ///< throws RigError naming the axis
+  int position_tolerance_steps = 0;  ///< read-back against command
+  void Check() const;                ///< throws RigError naming the axis
 };
 
 /// Drives the six axes. Every error kills all axes (best effort) and throws

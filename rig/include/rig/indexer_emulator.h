@@ -56,8 +56,8 @@ class IndexerEmulator {
   };
   void Serve();
   std::string Handle(const std::string& line);
-  long Now(const Unit& u) const;   ///< commanded position along the profile
-  void Settle(Unit& u) const;      ///< ends a finished move
+  long Now(const Unit& u) const;  ///< commanded position along the profile
+  void Settle(Unit& u) const;     ///< ends a finished move
   static std::string Reply(const std::string& text, bool ok);
 
   std::string path_;

@@ -31,7 +31,8 @@ std::string ReadInputFile(const std::string& path, const std::string& what,
 
 /// Throws InputError like ReadInputFile unless `path` is a regular file of
 /// at most `max_bytes` (for files another library opens itself).
-void CheckInputFile(const std::string& path, const std::string& what, std::uintmax_t max_bytes = kMaxInputFileBytes);
+void CheckInputFile(const std::string& path, const std::string& what,
+                    std::uintmax_t max_bytes = kMaxInputFileBytes);
 
 /// `text` as a message may echo it: at most `max_chars` characters (then
 /// "...", and how long it was), control characters shown as '?'.

@@ -41,8 +41,7 @@ class Simulation {
   /// Loads an MJCF scene file that includes the rig model. Throws SceneError
   /// (one line naming the file and the problem) if the file cannot be read or
   /// parsed, or lacks the rig; throws SceneError if `config` is invalid.
-  static std::unique_ptr<Simulation> Load(const std::string& scene_path,
-                                          const SimRigConfig& config,
+  static std::unique_ptr<Simulation> Load(const std::string& scene_path, const SimRigConfig& config,
                                           const AssetProvider& assets = {});
 
   /// Same, for a scene given as MJCF text (a generated scene); `name` stands
@@ -54,8 +53,8 @@ class Simulation {
   /// Compiles MJCF text with the rig and applies the checks a load applies
   /// (finite numbers, the rig included, the scene rules) without creating a
   /// renderer: cheap enough to check many scenes. Throws SceneError.
-  static void CheckScene(const std::string& name, const std::string& xml, const SimRigConfig& config,
-                         const AssetProvider& assets = {});
+  static void CheckScene(const std::string& name, const std::string& xml,
+                         const SimRigConfig& config, const AssetProvider& assets = {});
 
   ~Simulation();
   Simulation(const Simulation&) = delete;
