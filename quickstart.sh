@@ -10,7 +10,7 @@ export DEBIAN_FRONTEND=noninteractive
 # Debian 12 packages only; README "Dependencies" says what each is for.
 PACKAGES=(build-essential cmake pkg-config libmujoco-dev libosmesa6-dev libeigen3-dev
           libopencv-dev catch2 libcli11-dev nlohmann-json3-dev libyaml-cpp-dev gnuplot-nox libserial-dev
-          clang-14 libclang-rt-14-dev)
+          clang-14 libclang-rt-14-dev clang-format)
 JOBS=$(nproc)
 
 install_packages() {
