@@ -1,6 +1,6 @@
 // Stereo calibration against chessboards the simulator renders at known
 // poses: the recovered focal lengths and baseline against the true ones.
-#include "calibration.h"
+#include "experiments/calibration/calibration.h"
 
 #include <unistd.h>
 

@@ -1,11 +1,11 @@
 // The run configuration (experiments/src/config.h): one number parser,
 // YAML read strictly, and a dump that reads back to itself.
-#include "config.h"
+#include "experiments/config/config.h"
 
 #include <catch2/catch.hpp>
 #include <cmath>
 
-#include "output.h"
+#include "experiments/output/output.h"
 
 TEST_CASE("numbers: finite decimal text and nothing else", "[config]") {
   using experiments::ParseNumber;

@@ -2,8 +2,8 @@
 // scored against ground truth. Slow: labelled [slow].
 #include <catch2/catch.hpp>
 
+#include "experiments/scoring/foveal_eval.h"
 #include "fovea/idr.h"
-#include "foveal_eval.h"
 #include "scenes/catalog.h"
 
 TEST_CASE("foveal and peripheral depth accuracy at three fixations per scene", "[foveal][slow]") {

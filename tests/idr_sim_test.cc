@@ -2,7 +2,7 @@
 // ground truth. Slow: labelled [slow].
 #include <catch2/catch.hpp>
 
-#include "idr_eval.h"
+#include "experiments/scoring/idr_eval.h"
 #include "scenes/catalog.h"
 
 namespace {

@@ -1,6 +1,6 @@
 // The serial stage driver against the indexer emulator on a pseudo-terminal:
 // every command, every injected fault, and a long random sequence of moves.
-#include "rig/indexer.h"
+#include "rig/hardware/indexer.h"
 
 #include <signal.h>
 #include <sys/wait.h>
@@ -10,7 +10,7 @@
 #include <chrono>
 #include <random>
 
-#include "rig/indexer_emulator.h"
+#include "rig/hardware/indexer_emulator.h"
 
 namespace {
 

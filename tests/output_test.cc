@@ -2,7 +2,7 @@
 // empty, or replaced only when fovea wrote it and --force says so; results
 // appear whole under the target's name or not at all; nothing else is
 // touched.
-#include "output.h"
+#include "experiments/output/output.h"
 
 #include <unistd.h>
 

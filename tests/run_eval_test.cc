@@ -1,5 +1,5 @@
 // Ground-truth scoring's reference view.
-#include "run_eval.h"
+#include "experiments/scoring/run_eval.h"
 
 #include <catch2/catch.hpp>
 

@@ -5,7 +5,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "rig/indexer.h"
+#include "rig/hardware/indexer.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string bytes(reinterpret_cast<const char*>(data), size);

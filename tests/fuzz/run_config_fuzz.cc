@@ -5,8 +5,8 @@
 #include <cstdlib>
 #include <string>
 
-#include "config.h"
-#include "output.h"
+#include "experiments/config/config.h"
+#include "experiments/usage_error.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);

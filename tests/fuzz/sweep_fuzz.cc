@@ -6,8 +6,8 @@
 #include <set>
 #include <string>
 
-#include "output.h"
-#include "sweep.h"
+#include "experiments/config/sweep.h"
+#include "experiments/usage_error.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);

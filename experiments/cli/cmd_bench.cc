@@ -1,0 +1,222 @@
+// fovea bench: speed figures printed by the program, never asserted in tests.
+#include <chrono>
+#include <nlohmann/json.hpp>
+
+#include "commands.h"
+#include "experiments/output/output.h"
+#include "scene_options.h"
+
+namespace experiments {
+void AddBenchFixationCommand(CLI::App& bench, std::function<int()>* run);
+namespace {
+
+struct BenchRenderArgs {
+  SceneOptions scene;
+  int frames = 20;
+  bool json = false;
+};
+
+int BenchRender(const BenchRenderArgs& args) {
+  using Clock = std::chrono::steady_clock;
+  RunConfig config;
+  config.rig.noise.read_noise_sigma_dn = 0;  // rendering speed alone, unless --noise
+  args.scene.ApplyTo(&config);
+  auto sim = LoadSceneOf(config);
+  rig::Rig& rig = sim->rig();
+  rig.Capture();  // warm-up: texture upload, JIT of the software rasterizer
+  auto seconds = [](Clock::time_point t0) {
+    return std::chrono::duration<double>(Clock::now() - t0).count();
+  };
+  auto t0 = Clock::now();
+  for (int i = 0; i < args.frames; ++i) rig.Capture();
+  const double stereo_gray_s = seconds(t0);
+  t0 = Clock::now();
+  for (int i = 0; i < args.frames; ++i) rig.Capture({/*color=*/true});
+  const double stereo_color_s = seconds(t0);
+  const rig::StereoFrame frame = rig.Capture();
+  t0 = Clock::now();
+  for (int i = 0; i < args.frames; ++i)
+    sim->truth().Render(frame.left.world_T_camera, frame.left.intrinsics);
+  const double depth_s = seconds(t0);
+  t0 = Clock::now();
+  sim->truth().RayCastDepth(frame.left.world_T_camera, frame.left.intrinsics);
+  const double raycast_s = seconds(t0);
+
+  const auto& k = frame.left.intrinsics;
+  nlohmann::json j = {
+      {"scene", sim->scene_path()},
+      {"width_px", k.width_px},
+      {"height_px", k.height_px},
+      {"frames", args.frames},
+      {"camera_images_per_s", 2 * args.frames / stereo_gray_s},
+      {"stereo_pairs_per_s", args.frames / stereo_gray_s},
+      {"stereo_pairs_color_per_s", args.frames / stereo_color_s},
+      {"true_depth_images_per_s", args.frames / depth_s},
+      {"raycast_depth_image_s", raycast_s},
+  };
+  if (args.json) {
+    std::printf("%s\n", j.dump().c_str());
+  } else {
+    std::printf("render benchmark, %s, %dx%d, %d frames\n", sim->scene_path().c_str(), k.width_px,
+                k.height_px, args.frames);
+    std::printf("  camera images (gray, noise model)   %7.1f frames/s\n",
+                j["camera_images_per_s"].get<double>());
+    std::printf("  stereo pairs (gray)                 %7.1f pairs/s\n",
+                j["stereo_pairs_per_s"].get<double>());
+    std::printf("  stereo pairs (gray + colour)        %7.1f pairs/s\n",
+                j["stereo_pairs_color_per_s"].get<double>());
+    std::printf("  true depth (OpenGL depth buffer)    %7.1f images/s\n",
+                j["true_depth_images_per_s"].get<double>());
+    std::printf("  true depth (exact ray casting)      %7.3f s per image\n", raycast_s);
+  }
+  return 0;
+}
+
+}  // namespace
+
+void AddBenchCommand(CLI::App& app, std::function<int()>* run) {
+  CLI::App* bench = app.add_subcommand("bench", "speed benchmarks (figures for the README)");
+  bench->require_subcommand(1);
+  auto args = std::make_shared<BenchRenderArgs>();
+  CLI::App* render = bench->add_subcommand("render", "offscreen rendering speed");
+  args->scene.Register(render, /*with_state=*/false);
+  render->add_option("--frames", args->frames, "frames per measurement")
+      ->check(CLI::Range(1, 10000));
+  render->add_flag("--json", args->json, "one JSON object on stdout");
+  render->callback([args, run] { *run = [args] { return BenchRender(*args); }; });
+  AddBenchFixationCommand(*bench, run);
+}
+
+}  // namespace experiments
+
+// fovea bench fixation: the foveated process against full-resolution NL1
+// and against StereoSGBM on the rectified full frame, one run, one machine.
+#include <opencv2/imgproc.hpp>
+
+#include "experiments/scoring/foveal_eval.h"
+#include "fovea/idr.h"
+#include "fovea/sgbm.h"
+
+namespace experiments {
+namespace {
+
+struct BenchFixationArgs {
+  SceneOptions scene;
+  std::vector<std::string> point{"0", "0.89", "0"};
+  bool json = false;
+};
+
+int BenchFixation(const BenchFixationArgs& args) {
+  using Clock = std::chrono::steady_clock;
+  auto ms = [](Clock::time_point t0) {
+    return 1e3 * std::chrono::duration<double>(Clock::now() - t0).count();
+  };
+  RunConfig config;  // the run's defaults: noise on
+  args.scene.ApplyTo(&config);
+  const Eigen::Vector3d p(*ParseNumber(args.point[0]), *ParseNumber(args.point[1]),
+                          *ParseNumber(args.point[2]));
+  auto sim = LoadSceneOf(config);
+  rig::Rig& rig = sim->rig();
+  const fovea::IdrResult idr = fovea::RunIdr(rig, {});
+  const fovea::Nl1Matcher nl1;
+  const fovea::FixationResult r = fovea::Fixate(rig, idr.map, p, nl1, {});
+  if (!r.ok) throw std::runtime_error("cannot fixate the benchmark point: " + r.why);
+  const FovealScore score = ScoreFoveal(r, sim->truth());
+  double foveated_ms = 0;
+  for (const auto& level : r.foveal.levels) foveated_ms += 1e3 * level.match_time_s;
+
+  const rig::StereoFrame& frame = r.servo.frame;
+  const rig::CameraView& left = frame.left;
+  const rig::CameraIntrinsics& k = left.intrinsics;
+  const fovea::Tessellation& t = r.foveal.tessellation;
+  const Eigen::Isometry3d right_T_left = frame.right.world_T_camera.inverse() * left.world_T_camera;
+  auto disparity_at = [&](double u, double v, double z) {
+    const Eigen::Vector3d p_R = right_T_left * (z * k.Ray({u, v}));
+    return u - (frame.right.intrinsics.fx_px * p_R.x() / p_R.z() + frame.right.intrinsics.cx_px);
+  };
+  // The same depth range the fovea searches: Z_T about the fixation depth.
+  const double z_near = t.fixation_depth_m - t.z_t_near_m, z_far = t.fixation_depth_m + t.z_t_far_m;
+  const double d_lo = disparity_at(k.cx_px, k.cy_px, z_far),
+               d_hi = disparity_at(k.cx_px, k.cy_px, z_near);
+
+  // Full-resolution NL1 over the whole frame.
+  auto t0 = Clock::now();
+  const fovea::DisparityMap full =
+      nl1.Match(left.gray, frame.right.gray,
+                cv::Mat(left.gray.size(), CV_32F, cv::Scalar(std::min(d_lo, d_hi) - 1)),
+                cv::Mat(left.gray.size(), CV_32F, cv::Scalar(std::max(d_lo, d_hi) + 1)));
+  const double full_ms = ms(t0);
+  // StereoSGBM on the rectified full frame.
+  t0 = Clock::now();
+  const cv::Mat sgbm_depth = fovea::RectifiedSgbmDepth(left, frame.right, z_near, z_far);
+  const double sgbm_ms = ms(t0);
+
+  // Errors on the same foveal pixels (level 0, unmasked, with truth).
+  const cv::Mat truth = sim->truth().RayCastDepth(left.world_T_camera, k);
+  std::vector<double> full_err, sgbm_err;
+  int fovea_pixels = 0;
+  const cv::Rect& fovea = t.rects[0];
+  for (int v = fovea.y; v < fovea.y + fovea.height; ++v)
+    for (int u = fovea.x; u < fovea.x + fovea.width; ++u) {
+      const float zt = truth.at<float>(v, u);
+      if (zt <= 0 || !t.mask.at<uchar>(v, u)) continue;
+      ++fovea_pixels;
+      const double dt = disparity_at(u, v, zt);
+      const float df = full.disparity_px.at<float>(v, u);
+      if (std::isfinite(df)) full_err.push_back(std::abs(df - dt));
+      const float zs = sgbm_depth.at<float>(v, u);
+      if (zs > 0) sgbm_err.push_back(std::abs(disparity_at(u, v, zs) - dt));
+    }
+  auto median = [](std::vector<double> e) {
+    if (e.empty()) return std::nan("");
+    std::nth_element(e.begin(), e.begin() + e.size() / 2, e.end());
+    return e[e.size() / 2];
+  };
+  nlohmann::json j = {
+      {"scene", sim->scene_path()},
+      {"fovea_px", {fovea.width, fovea.height}},
+      {"levels", t.rects.size()},
+      {"foveated_ms", foveated_ms},
+      {"full_res_ms", full_ms},
+      {"sgbm_ms", sgbm_ms},
+      {"foveal_error_px", score.levels[0].median_disparity_error_px},
+      {"full_res_error_px", median(full_err)},
+      {"sgbm_error_px", median(sgbm_err)},
+      {"full_res_fovea_coverage", fovea_pixels ? double(full_err.size()) / fovea_pixels : 0.0},
+      {"sgbm_fovea_coverage", fovea_pixels ? double(sgbm_err.size()) / fovea_pixels : 0.0},
+      {"foveal_coverage", score.fovea_coverage},
+      {"disparity_range_px", {std::min(d_lo, d_hi), std::max(d_lo, d_hi)}},
+      {"full_res_over_foveated", full_ms / foveated_ms},
+      {"sgbm_over_foveated", sgbm_ms / foveated_ms}};
+  if (args.json) {
+    std::printf("%s\n", j.dump().c_str());
+  } else {
+    std::printf("fixation benchmark, %s, fovea %dx%d, %zu levels\n", sim->scene_path().c_str(),
+                fovea.width, fovea.height, t.rects.size());
+    std::printf("  foveated NL1 (all levels)   %8.1f ms   foveal error %.3f px\n", foveated_ms,
+                j["foveal_error_px"].get<double>());
+    std::printf("  full-resolution NL1         %8.1f ms   foveal error %.3f px  (%.1fx the time)\n",
+                full_ms, j["full_res_error_px"].get<double>(), full_ms / foveated_ms);
+    std::printf("  StereoSGBM, rectified frame %8.1f ms   foveal error %.3f px  (%.1fx the time)\n",
+                sgbm_ms, j["sgbm_error_px"].get<double>(), sgbm_ms / foveated_ms);
+  }
+  return 0;
+}
+
+}  // namespace
+
+void AddBenchFixationCommand(CLI::App& bench, std::function<int()>* run) {
+  auto args = std::make_shared<BenchFixationArgs>();
+  args->scene.scene = "cylinder_planes";
+  CLI::App* cmd =
+      bench.add_subcommand("fixation", "foveated matching vs full-resolution NL1 vs StereoSGBM");
+  args->scene.Register(cmd, /*with_state=*/false);
+  cmd->add_option("--point", args->point, "fixation point X Y Z, metres")
+      ->expected(3)
+      ->check(NumberIn(-100, 100))
+      ->capture_default_str();
+  cmd->add_flag("--json", args->json, "one JSON object on stdout");
+  cmd->callback([args, run] { *run = [args] { return BenchFixation(*args); }; });
+}
+
+}  // namespace experiments

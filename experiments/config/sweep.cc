@@ -1,0 +1,354 @@
+#include "experiments/config/sweep.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <optional>
+#include <set>
+#include <sstream>
+
+#include "experiments/usage_error.h"
+#include "scenes/catalog.h"
+
+namespace experiments {
+namespace fs = std::filesystem;
+namespace {
+
+std::string Number(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.12g", v);
+  return buf;
+}
+
+// The values of one axis: a list of scalars, or {from, to, step | count}.
+std::vector<std::string> AxisValues(const YAML::Node& node, const std::string& where) {
+  std::vector<std::string> values;
+  if (node.IsSequence()) {
+    for (const auto& v : node) {
+      if (!v.IsScalar()) throw UsageError(where + "expected a list of single values");
+      values.push_back(v.Scalar());
+    }
+  } else if (node.IsMap()) {
+    std::map<std::string, double> r;
+    for (const auto& kv : node) {
+      const std::string key = kv.first.as<std::string>();
+      if (key != "from" && key != "to" && key != "step" && key != "count")
+        throw UsageError(where + "unknown range key '" + key +
+                         "' (expected from, to, step or count)");
+      const std::optional<double> v =
+          kv.second.IsScalar() ? ParseNumber(kv.second.Scalar()) : std::nullopt;
+      if (!v) throw UsageError(where + "range key '" + key + "': expected a number");
+      r[key] = *v;
+    }
+    if (!r.count("from") || !r.count("to")) throw UsageError(where + "a range needs from and to");
+    if (r.count("step") == r.count("count"))
+      throw UsageError(where + "a range needs exactly one of step or count");
+    const double from = r["from"], to = r["to"];
+    int n;
+    double step;
+    if (r.count("count")) {
+      if (!(r["count"] >= 1 && r["count"] <= kMaxSweepRuns && r["count"] == std::floor(r["count"])))
+        throw UsageError(where + "range count must be a whole number from 1 to " +
+                         std::to_string(kMaxSweepRuns));
+      n = static_cast<int>(r["count"]);
+      step = n > 1 ? (to - from) / (n - 1) : 0;
+    } else {
+      step = r["step"];
+      if (!(step > 0)) throw UsageError(where + "range step must be positive");
+      if (to < from) throw UsageError(where + "range needs from <= to");
+      const double k = std::floor((to - from) / step + 1e-9);
+      if (k + 1 > kMaxSweepRuns)
+        throw UsageError(where + "range has more than " + std::to_string(kMaxSweepRuns) +
+                         " values");
+      n = static_cast<int>(k) + 1;
+    }
+    for (int i = 0; i < n; ++i) values.push_back(Number(from + i * step));
+  } else if (node.IsScalar()) {
+    values.push_back(node.Scalar());
+  } else {
+    throw UsageError(where + "expected a list of values or a range {from, to, step}");
+  }
+  if (values.empty()) throw UsageError(where + "has no values");
+  return values;
+}
+
+void CheckScene(const std::string& scene, const std::string& where) {
+  if (scene.empty()) return;
+  try {
+    const std::string path = scenes::ResolveScene(scene);
+    if (path.rfind("random:", 0) != 0 && !fs::is_regular_file(path))
+      throw UsageError(where + "scene '" + scene + "': no such file");
+  } catch (const sim::SceneError& e) {
+    throw UsageError(where + e.what());
+  }
+}
+
+std::string Variant(const RunConfig& c) {
+  if (c.method == "static_sgbm") return "static_sgbm";
+  return c.fovea.selection.deterministic ? "deterministic" : "fovea";
+}
+
+// Axes a static baseline keeps (the rest do not concern it).
+bool ConcernsStatic(const std::string& path) {
+  return path == "scene" || path == "seed" || path.rfind("rig.", 0) == 0 ||
+         path.rfind("static.", 0) == 0 || path == "idr.z_min_m" || path == "foveal.fovea_patch_px";
+}
+
+}  // namespace
+
+Sweep LoadSweep(const std::string& path) {
+  std::string text;
+  try {
+    text = rig::ReadInputFile(path, "file");
+  } catch (const rig::InputError& e) {
+    throw UsageError("sweep " + rig::ClipForMessage(path) + ": " + e.what());
+  }
+  return ParseSweep(text, path);
+}
+
+Sweep ParseSweep(const std::string& text, const std::string& path) {
+  const std::string where = "sweep " + rig::ClipForMessage(path) + ": ";
+  const YAML::Node root = ParseYaml(text, where);
+  if (!root.IsMap())
+    throw UsageError(where + "expected a mapping with base, config, axes, baselines, jobs");
+  Sweep sweep;
+  sweep.file = path;
+  RunConfig base;
+  for (const auto& kv : root) {
+    const std::string key = kv.first.as<std::string>();
+    if (key != "base" && key != "config" && key != "axes" && key != "baselines" && key != "jobs")
+      throw UsageError(where + "unknown key '" + rig::ClipForMessage(key) +
+                       "' (expected base, config, axes, baselines, jobs)");
+  }
+  if (root["base"]) {
+    if (!root["base"].IsScalar()) throw UsageError(where + "key 'base': expected a file name");
+    fs::path b = root["base"].Scalar();
+    if (b.is_relative()) b = fs::path(path).parent_path() / b;
+    base = LoadConfig(b.string());
+  }
+  if (root["config"]) {
+    if (!root["config"].IsMap())
+      throw UsageError(where + "key 'config': expected a mapping of parameters");
+    ApplyYaml(root["config"], &base, where + "config: ");
+  }
+  if (root["jobs"]) {
+    const std::optional<double> jobs =
+        root["jobs"].IsScalar() ? ParseNumber(root["jobs"].Scalar()) : std::nullopt;
+    if (!jobs || *jobs != std::floor(*jobs) || *jobs < 0 || *jobs > 1024)
+      throw UsageError(where + "key 'jobs': expected a whole number in [0, 1024] (0 = every core)");
+    sweep.jobs = static_cast<int>(*jobs);
+  }
+  if (!root["axes"] || !root["axes"].IsMap() || root["axes"].size() == 0)
+    throw UsageError(where + "key 'axes': expected a mapping of parameter paths to values");
+  for (const auto& kv : root["axes"]) {
+    SweepAxis axis;
+    axis.path = kv.first.as<std::string>();
+    const std::string at = where + "axes: key '" + axis.path + "': ";
+    {
+      RunConfig probe;
+      try {
+        ParamText(&probe, axis.path);
+      } catch (const UsageError&) {
+        throw UsageError(where + "axes: unknown key '" + rig::ClipForMessage(axis.path) + "'");
+      }
+    }
+    axis.values = AxisValues(kv.second, at);
+    for (const std::string& v : axis.values) {
+      RunConfig probe = base;
+      try {
+        SetParam(&probe, axis.path, v);
+      } catch (const UsageError& e) {
+        throw UsageError(where + "axes: " + e.what());
+      }
+      if (axis.path == "scene") CheckScene(v, where + "axes: key 'scene': ");
+    }
+    for (const SweepAxis& a : sweep.axes)
+      if (a.path == axis.path)
+        throw UsageError(where + "axes: key '" + axis.path + "' appears twice");
+    sweep.axes.push_back(axis);
+  }
+  if (root["baselines"]) {
+    if (!root["baselines"].IsSequence())
+      throw UsageError(where + "key 'baselines': expected a list");
+    for (const auto& b : root["baselines"]) {
+      const std::string name = b.IsScalar() ? b.Scalar() : "";
+      if (name != "deterministic" && name != "static_sgbm")
+        throw UsageError(where + "key 'baselines': '" + rig::ClipForMessage(name) +
+                         "' is not one of deterministic, static_sgbm");
+      sweep.baselines.push_back(name);
+    }
+  }
+
+  // The grid, last axis fastest.
+  long total = 1;
+  for (const SweepAxis& a : sweep.axes) {
+    total *= static_cast<long>(a.values.size());
+    if (total * static_cast<long>(1 + sweep.baselines.size()) > kMaxSweepRuns)
+      throw UsageError(where + "the grid has more than " + std::to_string(kMaxSweepRuns) +
+                       " runs (the limit of one sweep; split it into several)");
+  }
+  std::set<std::string> seen;
+  auto add = [&](const RunConfig& c,
+                 const std::vector<std::pair<std::string, std::string>>& point) {
+    RunConfig config = c;
+    if (config.scene.empty()) config.scene = scenes::kDefaultScene;
+    try {
+      config.Check();
+    } catch (const UsageError& e) {
+      std::string at;
+      for (const auto& [p, v] : point) at += (at.empty() ? "" : ", ") + p + "=" + v;
+      throw UsageError(where + "run " + at + ": " + e.what());
+    }
+    SweepRun run{ConfigHash(config), Variant(config), config, point};
+    if (seen.insert(run.id).second) sweep.runs.push_back(std::move(run));
+  };
+  CheckScene(base.scene, where + "key 'scene': ");
+  std::vector<std::vector<std::pair<std::string, std::string>>> points;
+  std::vector<size_t> index(sweep.axes.size(), 0);
+  for (long i = 0; i < total; ++i) {
+    std::vector<std::pair<std::string, std::string>> point;
+    for (size_t a = 0; a < sweep.axes.size(); ++a)
+      point.emplace_back(sweep.axes[a].path, sweep.axes[a].values[index[a]]);
+    points.push_back(point);
+    for (size_t a = sweep.axes.size(); a-- > 0;) {
+      if (++index[a] < sweep.axes[a].values.size()) break;
+      index[a] = 0;
+    }
+  }
+  for (const auto& point : points) {
+    RunConfig c = base;
+    for (const auto& [p, v] : point) SetParam(&c, p, v);
+    add(c, point);
+  }
+  for (const std::string& b : sweep.baselines)
+    for (const auto& point : points) {
+      RunConfig c = base;
+      std::vector<std::pair<std::string, std::string>> kept;
+      for (const auto& [p, v] : point)
+        if (b == "deterministic" || ConcernsStatic(p)) {
+          SetParam(&c, p, v);
+          kept.emplace_back(p, v);
+        }
+      if (b == "deterministic")
+        c.fovea.selection.deterministic = true;
+      else
+        c.method = "static_sgbm";
+      add(c, kept);
+    }
+  return sweep;
+}
+
+nlohmann::json GridJson(const Sweep& sweep) {
+  nlohmann::json j;
+  j["axes"] = nlohmann::json::array();
+  for (const SweepAxis& a : sweep.axes)
+    j["axes"].push_back({{"path", a.path}, {"values", a.values}});
+  j["baselines"] = sweep.baselines;
+  j["runs"] = nlohmann::json::array();
+  for (const SweepRun& r : sweep.runs) {
+    nlohmann::json run;
+    run["id"] = r.id;
+    run["variant"] = r.variant;
+    run["point"] = nlohmann::json::object();
+    for (const auto& [p, v] : r.point) run["point"][p] = v;
+    nlohmann::json params = nlohmann::json::array();
+    for (const auto& [path, value] : ParamValues(r.config)) params.push_back({path, value});
+    run["config"] = params;
+    j["runs"].push_back(run);
+  }
+  return j;
+}
+
+bool IsWallClockColumn(const std::string& column) {
+  return column == "wall_time_s" || column == "compute_time_s" || column.rfind("time_s.", 0) == 0;
+}
+
+namespace {
+
+void Flatten(const nlohmann::json& j, const std::string& prefix,
+             std::map<std::string, std::string>* out) {
+  if (j.is_object()) {
+    for (auto it = j.begin(); it != j.end(); ++it)
+      Flatten(it.value(), prefix.empty() ? it.key() : prefix + "." + it.key(), out);
+  } else if (j.is_string()) {
+    (*out)[prefix] = j.get<std::string>();
+  } else if (j.is_number() || j.is_boolean()) {
+    (*out)[prefix] = j.dump();
+  }
+}
+
+std::string CsvField(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string q = "\"";
+  for (const char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
+
+}  // namespace
+
+nlohmann::json ReadJson(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error("cannot read '" + path + "'");
+  try {
+    return nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw std::runtime_error("'" + path + "' is not valid JSON: " + e.what());
+  }
+}
+
+std::string ResultsCsv(const std::string& dir, const nlohmann::json& grid,
+                       std::vector<std::string>* missing) {
+  std::vector<std::string> param_columns;
+  for (const auto& p : grid.at("runs").at(0).at("config"))
+    param_columns.push_back(p.at(0).get<std::string>());
+  std::vector<std::map<std::string, std::string>> rows;
+  std::set<std::string> figure_columns;
+  for (const auto& run : grid.at("runs")) {
+    const std::string id = run.at("id").get<std::string>();
+    const std::string summary_path = dir + "/runs/" + id + "/summary.json";
+    if (!fs::exists(summary_path)) {
+      missing->push_back(id);
+      continue;
+    }
+    std::map<std::string, std::string> figures;
+    Flatten(ReadJson(summary_path), "", &figures);
+    for (const char* own : {"scene", "seed", "method", "matcher"})
+      figures.erase(own);  // parameters already
+    for (const auto& [k, v] : figures) figure_columns.insert(k);
+    std::map<std::string, std::string> row = figures;
+    for (const auto& p : run.at("config"))
+      row["param:" + p.at(0).get<std::string>()] = p.at(1).get<std::string>();
+    row["run_id"] = id;
+    row["variant"] = run.at("variant").get<std::string>();
+    rows.push_back(std::move(row));
+  }
+  std::string csv = "run_id,variant";
+  for (const std::string& c : param_columns) csv += "," + CsvField(c);
+  for (const std::string& c : figure_columns) csv += "," + CsvField(c);
+  csv += "\n";
+  for (const auto& row : rows) {
+    auto get = [&](const std::string& k) {
+      const auto it = row.find(k);
+      return it == row.end() ? std::string() : CsvField(it->second);
+    };
+    csv += get("run_id") + "," + get("variant");
+    for (const std::string& c : param_columns) csv += "," + get("param:" + c);
+    for (const std::string& c : figure_columns) csv += "," + get(c);
+    csv += "\n";
+  }
+  return csv;
+}
+
+std::pair<int, int> ParseShard(const std::string& text) {
+  int i = 0, n = 0;
+  char extra;
+  if (std::sscanf(text.c_str(), "%d/%d%c", &i, &n, &extra) != 2 || n < 1 || i < 1 || i > n)
+    throw UsageError("--shard expects I/N with 1 <= I <= N, got '" + text + "'");
+  return {i, n};
+}
+
+}  // namespace experiments

@@ -1,0 +1,377 @@
+#include "experiments/output/report.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+#include "experiments/config/sweep.h"
+#include "experiments/output/output.h"
+
+namespace experiments {
+namespace fs = std::filesystem;
+namespace {
+
+std::string Base64(const std::string& bytes) {
+  static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  size_t i = 0;
+  for (; i + 2 < bytes.size(); i += 3) {
+    const unsigned v = (unsigned char)bytes[i] << 16 | (unsigned char)bytes[i + 1] << 8 |
+                       (unsigned char)bytes[i + 2];
+    out += {k[v >> 18], k[(v >> 12) & 63], k[(v >> 6) & 63], k[v & 63]};
+  }
+  if (i + 1 == bytes.size()) {
+    const unsigned v = (unsigned char)bytes[i] << 16;
+    out += {k[v >> 18], k[(v >> 12) & 63], '=', '='};
+  } else if (i + 2 == bytes.size()) {
+    const unsigned v = (unsigned char)bytes[i] << 16 | (unsigned char)bytes[i + 1] << 8;
+    out += {k[v >> 18], k[(v >> 12) & 63], k[(v >> 6) & 63], '='};
+  }
+  return out;
+}
+
+std::string Html(const std::string& s) {
+  std::string o;
+  for (const char c : s) {
+    if (c == '<')
+      o += "&lt;";
+    else if (c == '>')
+      o += "&gt;";
+    else if (c == '&')
+      o += "&amp;";
+    else
+      o += c;
+  }
+  return o;
+}
+
+// gnuplot strings are single-quoted: double any quote.
+std::string Quoted(const std::string& s) {
+  std::string o = "'";
+  for (const char c : s) o += c == '\'' ? std::string("''") : std::string(1, c);
+  return o + "'";
+}
+
+std::string Img(const std::string& path, const std::string& alt) {
+  return "<figure><img src=\"data:image/png;base64," + Base64(ReadFile(path)) + "\" alt=\"" +
+         Html(alt) + "\"><figcaption>" + Html(alt) + "</figcaption></figure>\n";
+}
+
+std::string Fmt(double v, const char* f = "%.4g") {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, f, v);
+  return buf;
+}
+
+const char* kStyle =
+    "<style>body{font-family:sans-serif;margin:2em;max-width:1400px;color:#222}"
+    "table{border-collapse:collapse;font-size:13px}td,th{border:1px solid #ccc;padding:3px "
+    "8px;text-align:right}"
+    "th{background:#f0f0f0}td.l,th.l{text-align:left}img{max-width:100%}figure{margin:1em 0}"
+    "figcaption{font-size:13px;color:#555}.plots{display:flex;flex-wrap:wrap;gap:1em}"
+    "h2{border-bottom:1px solid #ddd;padding-bottom:4px}</style>\n";
+
+double Num(const nlohmann::json& j, const std::string& dotted) {
+  const nlohmann::json* p = &j;
+  std::stringstream ss(dotted);
+  std::string part;
+  while (std::getline(ss, part, '.')) {
+    if (!p->is_object() || !p->contains(part)) return std::nan("");
+    p = &(*p)[part];
+  }
+  return p->is_number() ? p->get<double>() : std::nan("");
+}
+
+std::string RunReport(const std::string& dir) {
+  const nlohmann::json s = ReadJson(dir + "/summary.json");
+  std::string h =
+      "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>FOVEA run: " + Html(dir) +
+      "</title>" + kStyle + "</head><body>\n";
+  h += "<h1>FOVEA run</h1><p>Folder <code>" + Html(dir) + "</code>, scene <code>" +
+       Html(s.value("scene", std::string())) + "</code>, seed " +
+       s.value("seed", nlohmann::json(0)).dump() + ", method " +
+       Html(s.value("method", std::string("fovea"))) + ".</p>\n";
+  h += "<h2>Figures</h2><table>";
+  const std::vector<std::pair<std::string, std::string>> rows = {
+      {"fixations", "fixations done"},
+      {"coverage", "coverage of visible textured pixels"},
+      {"foveal_coverage", "share mapped at foveal resolution"},
+      {"median_abs_error_m", "median |depth error|, m"},
+      {"median_rel_error", "median relative error"},
+      {"median_error_steps", "median error, disparity steps"},
+      {"rmse_m", "RMSE, m"},
+      {"within_1pct", "share within 1% of depth"},
+      {"patch_3d_error.median_m", "median per-patch 3D error, m"},
+      {"motion_time_s", "simulated motion time, s"},
+      {"compute_time_s", "compute time, s"},
+      {"wall_time_s", "wall time, s"}};
+  for (const auto& [key, label] : rows) {
+    const double v = Num(s, key);
+    if (std::isfinite(v))
+      h += "<tr><th class=l>" + Html(label) + "</th><td>" + Fmt(v) + "</td></tr>";
+  }
+  h += "</table>\n";
+  if (s.contains("by_level")) {
+    h += "<h3>By level</h3><table><tr><th class=l>level</th><th>share</th><th>median error, "
+         "m</th><th>median "
+         "error, steps</th><th>RMSE, m</th></tr>";
+    for (auto it = s["by_level"].begin(); it != s["by_level"].end(); ++it)
+      h += "<tr><td class=l>" + it.key() + "</td><td>" + Fmt(Num(it.value(), "share")) +
+           "</td><td>" + Fmt(Num(it.value(), "median_abs_error_m")) + "</td><td>" +
+           Fmt(Num(it.value(), "median_error_steps")) + "</td><td>" +
+           Fmt(Num(it.value(), "rmse_m")) + "</td></tr>";
+    h += "</table>\n";
+  }
+  if (s.contains("by_surface")) {
+    h += "<h3>By surface</h3><table><tr><th "
+         "class=l>surface</th><th>pixels</th><th>coverage</th><th>foveal</th>"
+         "<th>median error, m</th></tr>";
+    for (auto it = s["by_surface"].begin(); it != s["by_surface"].end(); ++it)
+      h += "<tr><td class=l>" + Html(it.key()) + "</td><td>" +
+           Fmt(Num(it.value(), "pixels"), "%.0f") + "</td><td>" + Fmt(Num(it.value(), "coverage")) +
+           "</td><td>" + Fmt(Num(it.value(), "foveal_coverage")) + "</td><td>" +
+           Fmt(Num(it.value(), "median_abs_error_m")) + "</td></tr>";
+    h += "</table>\n";
+  }
+
+  // Curves against fixation count, from the per-fixation records.
+  Series cov{"coverage"}, fov{"foveal coverage"}, med{"median |error|"}, rmse{"RMSE"};
+  std::ifstream in(dir + "/fixations.jsonl");
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty()) continue;
+    const nlohmann::json r = nlohmann::json::parse(line);
+    if (!r.value("ok", false)) continue;
+    const double f = r.at("fixation").get<double>();
+    const nlohmann::json& sc = r.at("score");
+    cov.x.push_back(f), cov.y.push_back(Num(sc, "coverage"));
+    fov.x.push_back(f), fov.y.push_back(Num(sc, "foveal_coverage"));
+    med.x.push_back(f), med.y.push_back(1e3 * Num(sc, "median_abs_error_m"));
+    rmse.x.push_back(f), rmse.y.push_back(1e3 * Num(sc, "rmse_m"));
+  }
+  if (!cov.x.empty()) {
+    h += "<h2>Against fixation count</h2><div class=plots>";
+    h += GnuplotSvg("Coverage of the reference view", "fixation",
+                    "share of visible textured pixels", {cov, fov});
+    h += GnuplotSvg("Depth error", "fixation", "mm", {med, rmse}, true);
+    h += "</div>\n";
+  }
+  h += "<h2>Pictures</h2>\n";
+  for (const int k : {1, 5, 15, 25}) {
+    char name[32];
+    std::snprintf(name, sizeof name, "/map_after_%02d.png", k);
+    if (fs::exists(dir + name)) h += Img(dir + name, "the map after fixation " + std::to_string(k));
+  }
+  if (fs::exists(dir + "/map.png")) h += Img(dir + "/map.png", "the map");
+  if (fs::exists(dir + "/fixation_path.png"))
+    h += Img(dir + "/fixation_path.png", "the fixation path");
+  h += "</body></html>\n";
+  return h;
+}
+
+std::string SweepReport(const std::string& dir) {
+  const nlohmann::json grid = ReadJson(dir + "/grid.json");
+  struct Row {
+    std::string id, variant, scene;
+    std::map<std::string, std::string> point;
+    nlohmann::json summary;
+  };
+  std::vector<Row> rows;
+  int missing = 0;
+  for (const auto& run : grid.at("runs")) {
+    const std::string id = run.at("id").get<std::string>();
+    if (!fs::exists(dir + "/runs/" + id + "/summary.json")) {
+      ++missing;
+      continue;
+    }
+    Row r{id,
+          run.at("variant").get<std::string>(),
+          "",
+          {},
+          ReadJson(dir + "/runs/" + id + "/summary.json")};
+    for (auto it = run.at("point").begin(); it != run.at("point").end(); ++it)
+      r.point[it.key()] = it.value();
+    for (const auto& p : run.at("config"))
+      if (p.at(0) == "scene") r.scene = p.at(1).get<std::string>();
+    rows.push_back(r);
+  }
+  std::string h =
+      "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>FOVEA sweep: " + Html(dir) +
+      "</title>" + kStyle + "</head><body>\n<h1>FOVEA sweep</h1>\n";
+  h += "<p>Folder <code>" + Html(dir) + "</code>: " + std::to_string(rows.size()) +
+       " runs with results" +
+       (missing ? ", " + std::to_string(missing) + " without" : std::string()) +
+       ". Data: <code>results.csv</code> (a row per run). Axes:</p><ul>";
+  for (const auto& a : grid.at("axes")) {
+    std::string values;
+    for (const auto& v : a.at("values"))
+      values += (values.empty() ? "" : ", ") + v.get<std::string>();
+    h +=
+        "<li><code>" + Html(a.at("path").get<std::string>()) + "</code>: " + Html(values) + "</li>";
+  }
+  std::string baselines;
+  for (const auto& b : grid.at("baselines"))
+    baselines += (baselines.empty() ? "" : ", ") + b.get<std::string>();
+  h += "</ul><p>Baselines: " + (baselines.empty() ? std::string("none") : Html(baselines)) +
+       " (static_sgbm: StereoSGBM on the static parallel pair; deterministic: always the "
+       "composite's maximum).</p>\n";
+
+  const std::vector<std::pair<std::string, std::string>> figures = {
+      {"coverage", "coverage"},
+      {"foveal_coverage", "foveal coverage"},
+      {"median_abs_error_m", "median |depth error|, m"},
+      {"median_rel_error", "median relative error"},
+      {"rmse_m", "RMSE, m"},
+      {"motion_time_s", "simulated motion time, s"},
+      {"wall_time_s", "wall time, s"}};
+  for (const auto& a : grid.at("axes")) {
+    const std::string path = a.at("path").get<std::string>();
+    if (path == "scene" || path == "seed") continue;
+    std::vector<double> xs;
+    bool numeric = true;
+    for (const auto& v : a.at("values")) {
+      char* end = nullptr;
+      const std::string t = v.get<std::string>();
+      xs.push_back(std::strtod(t.c_str(), &end));
+      numeric &= end && *end == '\0' && !t.empty();
+    }
+    if (!numeric || xs.size() < 2) continue;
+    const double x_min = *std::min_element(xs.begin(), xs.end()),
+                 x_max = *std::max_element(xs.begin(), xs.end());
+    h += "<h2>Against <code>" + Html(path) +
+         "</code></h2><p>A line per scene and variant: the mean over the "
+         "other axes (seeds, ...), bars from the smallest to the largest value. Baselines that do "
+         "not depend "
+         "on this parameter are dashed horizontal lines.</p><div class=plots>\n";
+    for (const auto& [key, label] : figures) {
+      // (scene, variant) -> x -> values
+      std::map<std::pair<std::string, std::string>, std::map<double, std::vector<double>>> groups;
+      std::map<std::pair<std::string, std::string>, std::vector<double>> flat;
+      for (const Row& r : rows) {
+        const double v = Num(r.summary, key);
+        if (!std::isfinite(v)) continue;
+        const auto it = r.point.find(path);
+        if (it != r.point.end())
+          groups[{r.scene, r.variant}][std::strtod(it->second.c_str(), nullptr)].push_back(v);
+        else
+          flat[{r.scene, r.variant}].push_back(v);
+      }
+      std::vector<Series> series;
+      for (const auto& [g, by_x] : groups) {
+        Series s{g.first + ", " + g.second};
+        for (const auto& [x, vs] : by_x) {
+          double sum = 0;
+          for (const double v : vs) sum += v;
+          s.x.push_back(x);
+          s.y.push_back(sum / vs.size());
+          s.y_lo.push_back(*std::min_element(vs.begin(), vs.end()));
+          s.y_hi.push_back(*std::max_element(vs.begin(), vs.end()));
+        }
+        series.push_back(s);
+      }
+      for (const auto& [g, vs] : flat) {
+        double sum = 0;
+        for (const double v : vs) sum += v;
+        Series s{g.first + ", " + g.second};
+        s.x = {x_min, x_max};
+        s.y = {sum / vs.size(), sum / vs.size()};
+        s.dashed = true;
+        series.push_back(s);
+      }
+      if (!series.empty()) h += GnuplotSvg(label, path, label, series);
+    }
+    h += "</div>\n";
+  }
+
+  h += "<h2>Runs</h2><table><tr><th class=l>run</th><th class=l>variant</th>";
+  std::set<std::string> axis_names;
+  for (const auto& a : grid.at("axes")) axis_names.insert(a.at("path").get<std::string>());
+  for (const auto& a : grid.at("axes"))
+    h += "<th class=l>" + Html(a.at("path").get<std::string>()) + "</th>";
+  for (const auto& [key, label] : figures) h += "<th>" + Html(label) + "</th>";
+  h += "</tr>\n";
+  for (const Row& r : rows) {
+    h += "<tr><td class=l><a href=\"runs/" + r.id + "/\">" + r.id + "</a></td><td class=l>" +
+         r.variant + "</td>";
+    for (const auto& a : grid.at("axes")) {
+      const auto it = r.point.find(a.at("path").get<std::string>());
+      h += "<td class=l>" + (it == r.point.end() ? std::string("(base)") : Html(it->second)) +
+           "</td>";
+    }
+    for (const auto& [key, label] : figures) h += "<td>" + Fmt(Num(r.summary, key)) + "</td>";
+    h += "</tr>\n";
+  }
+  h += "</table></body></html>\n";
+  return h;
+}
+
+}  // namespace
+
+std::string GnuplotSvg(const std::string& title, const std::string& xlabel,
+                       const std::string& ylabel, const std::vector<Series>& series, bool log_y) {
+  const std::string base =
+      (fs::temp_directory_path() / ("fovea_plot_" + std::to_string(getpid()))).string();
+  std::ostringstream gp;
+  gp << "set terminal svg size 560,380 fixed noenhanced font 'sans,11' background rgb 'white'\n"
+     << "set output " << Quoted(base + ".svg") << "\n"
+     << "set title " << Quoted(title) << "\nset xlabel " << Quoted(xlabel) << "\nset ylabel "
+     << Quoted(ylabel)
+     << "\nset key outside below\nset grid\nset offsets graph 0.03, graph 0.03, graph 0.05, graph "
+        "0.05\n";
+  if (log_y) gp << "set logscale y\n";
+  std::string plot = "plot ";
+  for (size_t i = 0; i < series.size(); ++i) {
+    const Series& s = series[i];
+    const bool bars = !s.y_lo.empty();
+    plot += std::string(i ? ", " : "") + "'-' using 1:2" +
+            (bars ? ":3:4 with yerrorlines" : " with linespoints") + " lw 1.5 pt 7 ps 0.6" +
+            (s.dashed ? " dt 2" : "") + " title " + Quoted(s.title);
+  }
+  gp << plot << "\n";
+  for (const Series& s : series) {
+    for (size_t k = 0; k < s.x.size(); ++k) {
+      if (!std::isfinite(s.y[k]) || (log_y && s.y[k] <= 0)) continue;
+      gp << Fmt(s.x[k], "%.10g") << " " << Fmt(s.y[k], "%.10g");
+      if (!s.y_lo.empty()) gp << " " << Fmt(s.y_lo[k], "%.10g") << " " << Fmt(s.y_hi[k], "%.10g");
+      gp << "\n";
+    }
+    gp << "e\n";
+  }
+  {
+    std::ofstream out(base + ".gp");
+    out << gp.str();
+  }
+  const std::string cmd = "gnuplot " + base + ".gp 2>" + base + ".err";
+  const int status = std::system(cmd.c_str());
+  const std::string svg = ReadFile(base + ".svg");
+  const std::string err = ReadFile(base + ".err");
+  std::error_code ec;
+  for (const char* ext : {".gp", ".svg", ".err"}) fs::remove(base + ext, ec);
+  if (status != 0 || svg.empty())
+    throw std::runtime_error("gnuplot failed (is it installed? apt-get install gnuplot-nox): " +
+                             err.substr(0, err.find('\n')));
+  const size_t start = svg.find("<svg");
+  return "<div>" + (start == std::string::npos ? svg : svg.substr(start)) + "</div>\n";
+}
+
+std::string WriteReport(const std::string& dir) {
+  std::string page;
+  if (fs::exists(dir + "/grid.json"))
+    page = SweepReport(dir);
+  else if (fs::exists(dir + "/summary.json"))
+    page = RunReport(dir);
+  else
+    throw UsageError("'" + dir +
+                     "' is neither a run folder (summary.json) nor a sweep folder (grid.json)");
+  WriteTextAtomic(dir + "/report.html", page);
+  return dir + "/report.html";
+}
+
+}  // namespace experiments

@@ -1,0 +1,267 @@
+#include "experiments/scoring/run_eval.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "experiments/scoring/stats.h"
+#include "fovea/geometry.h"
+
+namespace experiments {
+namespace {
+
+struct Accumulator {
+  std::vector<double> abs, rel, steps;
+  double sum_sq = 0, sum_abs = 0;
+  long within = 0;
+  void Add(double z, double zt, double step) {
+    const double e = std::abs(z - zt);
+    abs.push_back(e);
+    rel.push_back(e / zt);
+    steps.push_back(e / step);
+    sum_sq += e * e;
+    sum_abs += e;
+    within += e <= 0.01 * zt;
+  }
+  ErrorFigures Figures(long total) const {
+    ErrorFigures f;
+    f.pixels = static_cast<long>(abs.size());
+    f.share = total ? double(f.pixels) / total : 0;
+    if (abs.empty()) return f;
+    f.median_abs_error_m = Quantile(abs, 0.5);
+    f.mean_abs_error_m = sum_abs / abs.size();
+    f.rmse_m = std::sqrt(sum_sq / abs.size());
+    f.median_rel_error = Quantile(rel, 0.5);
+    f.within_1pct = double(within) / abs.size();
+    f.median_error_steps = Quantile(steps, 0.5);
+    return f;
+  }
+};
+
+// Whether the right camera's optical centre, its carriage at one of
+// `carriages` and its head turned to p_W, has p_W in sight.
+bool RightCameraSees(const rig::RigGeometry& geometry, const std::vector<double>& carriages,
+                     const sim::GroundTruth& truth, const Eigen::Vector3d& p_W) {
+  // p_W lies on a surface: the ray reaches that surface within this share.
+  constexpr double kOnSurfaceShare = 0.005;
+  for (const double s : carriages) {
+    const Eigen::Vector3d c =
+        geometry.WorldFromCamera(rig::Side::kRight, geometry.FacingStage(rig::Side::kRight, s, p_W))
+            .translation();
+    const Eigen::Vector3d d = p_W - c;
+    const double distance = d.norm();
+    const auto hit = truth.CastRay(c, d / distance);
+    if (!hit || hit->distance_m >= (1 - kOnSurfaceShare) * distance) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+ReferenceView MakeReferenceView(rig::Rig& rig, const sim::GroundTruth& truth) {
+  ReferenceView ref;
+  rig.MoveTo(rig.Home());
+  ref.view = rig.Capture().left;
+  ref.depth_m = truth.RayCastDepth(ref.view.world_T_camera, ref.view.intrinsics, &ref.geom_ids);
+  ref.textured = truth.TexturedMask(ref.geom_ids);
+  ref.textured_pixels = cv::countNonZero(ref.textured);
+
+  const rig::AxisLimit& travel = rig.Limits()[rig::Axis::kRightBaseline];
+  std::vector<double> carriages;
+  for (int i = 0; i < kStereoPositions; ++i)
+    carriages.push_back(travel.min + (travel.max - travel.min) * i / (kStereoPositions - 1));
+  const Eigen::Vector3d axis = ref.view.world_T_camera.linear().col(2);
+  const rig::RigGeometry& geometry = rig.Geometry();
+  // Ray casts cost tens of microseconds each against a mesh: first the
+  // depth buffer of each carriage position's right camera (60 degrees wide,
+  // the head turned to the reference view's centre at its mean depth)
+  // accepts the points it shows within 1% of their depth; exact ray casts
+  // decide the rest.
+  constexpr double kDepthShare = 0.01;
+  const double mean_depth = cv::mean(ref.depth_m, ref.textured)[0];
+  const Eigen::Vector3d centre_W =
+      ref.view.world_T_camera * Eigen::Vector3d(0, 0, mean_depth > 0 ? mean_depth : 1);
+  const rig::CameraIntrinsics wide = rig::CameraIntrinsics::FromHorizontalFov(
+      ref.view.intrinsics.width_px, ref.view.intrinsics.height_px, M_PI / 3);
+  struct Seen {
+    Eigen::Isometry3d camera_T_world;
+    cv::Mat depth_m;
+  };
+  std::vector<Seen> renders;
+  for (const double s : carriages) {
+    const Eigen::Isometry3d world_T_camera = geometry.WorldFromCamera(
+        rig::Side::kRight, geometry.FacingStage(rig::Side::kRight, s, centre_W));
+    renders.push_back({world_T_camera.inverse(), truth.Render(world_T_camera, wide).depth_m});
+  }
+  auto rendered = [&](const Eigen::Vector3d& p_W) {
+    for (const Seen& seen : renders) {
+      const Eigen::Vector3d q = seen.camera_T_world * p_W;
+      if (q.z() <= 0) continue;
+      const int u = static_cast<int>(std::lround(wide.fx_px * q.x() / q.z() + wide.cx_px));
+      const int v = static_cast<int>(std::lround(wide.fy_px * q.y() / q.z() + wide.cy_px));
+      if (u < 0 || v < 0 || u >= seen.depth_m.cols || v >= seen.depth_m.rows) continue;
+      if (seen.depth_m.at<float>(v, u) >= (1 - kDepthShare) * q.z()) return true;
+    }
+    return false;
+  };
+  ref.stereo_visible = cv::Mat::zeros(ref.textured.size(), CV_8U);
+  for (int y = 0; y < ref.textured.rows; ++y)
+    for (int x = 0; x < ref.textured.cols; ++x) {
+      const float z = ref.depth_m.at<float>(y, x);
+      if (!ref.textured.at<uchar>(y, x) || z <= 0) continue;
+      const fovea::Ray ray = fovea::PixelRay(ref.view.world_T_camera, ref.view.intrinsics, {x, y});
+      const Eigen::Vector3d p = ray.origin_W + ray.direction_W * (z / ray.direction_W.dot(axis));
+      if (rendered(p) || RightCameraSees(geometry, carriages, truth, p))
+        ref.stereo_visible.at<uchar>(y, x) = 255;
+    }
+  ref.stereo_visible_pixels = cv::countNonZero(ref.stereo_visible);
+  return ref;
+}
+
+MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref,
+                  const sim::GroundTruth& truth, double baseline_m, bool per_patch) {
+  MapScore s;
+  cv::Mat depth, ids;
+  map.Render(ref.view.world_T_camera, ref.view.intrinsics, &depth, &ids);
+  const double f = ref.view.intrinsics.fx_px;
+  Accumulator all;
+  std::array<Accumulator, 3> level;
+  struct PerSurface {
+    long pixels = 0, mapped = 0, foveal = 0, stereo_visible = 0;
+    Accumulator errors;
+  };
+  std::map<int, PerSurface> surfaces;
+  long mapped = 0, foveal = 0, mapped_stereo_visible = 0;
+  for (int y = 0; y < depth.rows; ++y)
+    for (int x = 0; x < depth.cols; ++x) {
+      if (!ref.textured.at<uchar>(y, x)) continue;
+      const double zt = ref.depth_m.at<float>(y, x);
+      PerSurface& ps = surfaces[ref.geom_ids.at<int>(y, x)];
+      ++ps.pixels;
+      const bool paired = ref.stereo_visible.at<uchar>(y, x);
+      ps.stereo_visible += paired;
+      const int id = ids.at<int>(y, x);
+      if (id < 0 || zt <= 0) continue;
+      mapped_stereo_visible += paired;
+      const double z = depth.at<float>(y, x);
+      const int lv = static_cast<int>(map[id].level);
+      ++mapped;
+      ++ps.mapped;
+      if (lv == static_cast<int>(fovea::PatchLevel::kFoveal)) ++foveal, ++ps.foveal;
+      const double step = zt * zt / (f * baseline_m);
+      all.Add(z, zt, step);
+      level[lv].Add(z, zt, step);
+      ps.errors.Add(z, zt, step);
+    }
+  const long total = ref.textured_pixels;
+  s.coverage = total ? double(mapped) / total : 0;
+  s.foveal_coverage = total ? double(foveal) / total : 0;
+  s.stereo_visible_share = total ? double(ref.stereo_visible_pixels) / total : 0;
+  s.stereo_visible_coverage =
+      ref.stereo_visible_pixels ? double(mapped_stereo_visible) / ref.stereo_visible_pixels : 0;
+  s.overall = all.Figures(total);
+  for (int i = 0; i < 3; ++i) s.by_level[i] = level[i].Figures(total);
+  for (const auto& [geom, ps] : surfaces) {
+    SurfaceFigures sf;
+    sf.name = truth.GeomName(geom);
+    sf.pixels = ps.pixels;
+    sf.mapped = ps.mapped;
+    sf.coverage = double(ps.mapped) / ps.pixels;
+    sf.foveal_coverage = double(ps.foveal) / ps.pixels;
+    sf.stereo_visible_share = double(ps.stereo_visible) / ps.pixels;
+    const ErrorFigures e = ps.errors.Figures(ps.pixels);
+    sf.median_abs_error_m = e.median_abs_error_m;
+    sf.median_rel_error = e.median_rel_error;
+    sf.median_error_steps = e.median_error_steps;
+    sf.rmse_m = e.rmse_m;
+    s.surfaces.push_back(sf);
+  }
+  if (per_patch) {
+    s.has_patch_error = true;
+    std::vector<double> err;
+    for (const fovea::Patch& p : map.patches()) {
+      const Eigen::Vector3d c = p.Centre(), n = p.Normal();
+      double best = std::numeric_limits<double>::infinity();
+      for (const double sign : {1.0, -1.0}) {
+        const auto hit = truth.CastRay(c, sign * n);
+        if (hit) best = std::min(best, hit->distance_m);
+      }
+      if (std::isfinite(best)) err.push_back(best);
+    }
+    s.patches_scored = static_cast<int>(err.size());
+    s.patch_error_median_m = Quantile(err, 0.5);
+    s.patch_error_p90_m = Quantile(err, 0.9);
+  }
+  return s;
+}
+
+namespace {
+// A figure over `pixels` values: null when there were none.
+nlohmann::json Figure(long pixels, double value) {
+  return pixels > 0 ? nlohmann::json(value) : nlohmann::json();
+}
+
+nlohmann::json ErrorJson(const ErrorFigures& f) {
+  return {{"pixels", f.pixels},
+          {"share", f.share},
+          {"median_abs_error_m", Figure(f.pixels, f.median_abs_error_m)},
+          {"mean_abs_error_m", Figure(f.pixels, f.mean_abs_error_m)},
+          {"rmse_m", Figure(f.pixels, f.rmse_m)},
+          {"median_rel_error", Figure(f.pixels, f.median_rel_error)},
+          {"within_1pct", Figure(f.pixels, f.within_1pct)},
+          {"median_error_steps", Figure(f.pixels, f.median_error_steps)}};
+}
+}  // namespace
+
+nlohmann::json ScoreJson(const MapScore& s) {
+  const long n = s.overall.pixels;
+  nlohmann::json j;
+  j["coverage"] = s.coverage;
+  j["foveal_coverage"] = s.foveal_coverage;
+  j["stereo_visible_share"] = s.stereo_visible_share;
+  j["stereo_visible_coverage"] = s.stereo_visible_coverage;
+  j["median_abs_error_m"] = Figure(n, s.overall.median_abs_error_m);
+  j["median_rel_error"] = Figure(n, s.overall.median_rel_error);
+  j["rmse_m"] = Figure(n, s.overall.rmse_m);
+  j["mean_abs_error_m"] = Figure(n, s.overall.mean_abs_error_m);
+  j["within_1pct"] = Figure(n, s.overall.within_1pct);
+  j["median_error_steps"] = Figure(n, s.overall.median_error_steps);
+  for (int i = 0; i < 3; ++i)
+    j["by_level"][fovea::PatchLevelName(static_cast<fovea::PatchLevel>(i))] =
+        ErrorJson(s.by_level[i]);
+  for (const SurfaceFigures& sf : s.surfaces)
+    j["by_surface"][sf.name] = {{"pixels", sf.pixels},
+                                {"coverage", sf.coverage},
+                                {"foveal_coverage", sf.foveal_coverage},
+                                {"stereo_visible_share", sf.stereo_visible_share},
+                                {"median_abs_error_m", Figure(sf.mapped, sf.median_abs_error_m)},
+                                {"median_rel_error", Figure(sf.mapped, sf.median_rel_error)},
+                                {"median_error_steps", Figure(sf.mapped, sf.median_error_steps)},
+                                {"rmse_m", Figure(sf.mapped, sf.rmse_m)}};
+  if (s.has_patch_error)
+    j["patch_3d_error"] = {{"patches", s.patches_scored},
+                           {"median_m", Figure(s.patches_scored, s.patch_error_median_m)},
+                           {"p90_m", Figure(s.patches_scored, s.patch_error_p90_m)}};
+  return j;
+}
+
+std::string ScoreLine(const MapScore& s, bool brief) {
+  char line[256];
+  const ErrorFigures& e = s.overall;
+  if (e.pixels == 0) {
+    std::snprintf(line, sizeof line, "coverage %.3f, foveal %.3f, median error - (no mapped pixel)",
+                  s.coverage, s.foveal_coverage);
+  } else if (brief) {
+    std::snprintf(line, sizeof line, "coverage %.3f, foveal %.3f, median error %.2f mm", s.coverage,
+                  s.foveal_coverage, 1e3 * e.median_abs_error_m);
+  } else {
+    std::snprintf(
+        line, sizeof line,
+        "coverage %.3f, foveal %.3f, median error %.2f mm (%.3f%% of depth), RMSE %.2f mm",
+        s.coverage, s.foveal_coverage, 1e3 * e.median_abs_error_m, 100 * e.median_rel_error,
+        1e3 * e.rmse_m);
+  }
+  return line;
+}
+
+}  // namespace experiments
