@@ -169,7 +169,7 @@ TEST_CASE("bad sweep files each give one line naming the key, exit 2 and no outp
       {"missing_scene", "axes: {scene: [two_planes, no_such_scene]}\n",
        "unknown scene 'no_such_scene'"},
       {"missing_scene_file", "axes: {scene: [/nonexistent/scene.xml]}\n",
-       "scene '/nonexistent/scene.xml': no such file"},
+       "scene file '/nonexistent/scene.xml' cannot be read: no such file"},
       {"not_yaml", "axes: [1, 2\n", "not valid YAML"},
       {"unknown_axis", "axes: {foveal.nope: [1, 2]}\n", "unknown key 'foveal.nope'"},
       {"no_axes", "config: {seed: 3}\n", "key 'axes'"},
@@ -255,5 +255,22 @@ TEST_CASE("hardware rig setup errors are one line, non-zero exit and no output",
     CHECK(r.err.find(c.expect) != std::string::npos);
     CHECK_FALSE(fs::exists(out));
   }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("a sweep over catalog, generated and numbered random scenes runs", "[cli][sweep]") {
+  const fs::path dir = TempDir("scene_sweep");
+  fs::create_directories(dir);
+  std::ofstream(dir / "scenes.yaml")
+      << "config: {loop: {fixations: 1}, rig: {width_px: 160, height_px: 120}}\n"
+         "axes: {scene: [random, \"random:2\"]}\n";
+  const Result r = Fovea("sweep " + (dir / "scenes.yaml").string() +
+                         " --no-report --jobs 2 --out " + (dir / "out").string());
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  std::ifstream csv(dir / "out" / "results.csv");
+  int rows = -1;  // the header
+  for (std::string line; std::getline(csv, line);) rows += !line.empty();
+  CHECK(rows == 2);
   fs::remove_all(dir);
 }

@@ -2,6 +2,7 @@
 // scored against ground truth. Slow: labelled [slow].
 #include <catch2/catch.hpp>
 
+#include "experiments/config/config.h"
 #include "experiments/scoring/foveal_eval.h"
 #include "fovea/idr.h"
 #include "scenes/catalog.h"
@@ -19,13 +20,14 @@ TEST_CASE("foveal and peripheral depth accuracy at three fixations per scene", "
       {"cylinder_planes", {0.25, 1.0, -0.05}}, {"three_surfaces", {0.09, 0.86, 0.05}},
       {"three_surfaces", {0.15, 0.91, 0.1}},   {"three_surfaces", {-0.25, 1.2, 0.1}}};
   sim::SimRigConfig config;
-  config.noise.read_noise_sigma_dn = 2.0;
+  config.noise.read_noise_sigma_dn = experiments::kExperimentNoiseSigmaDn;
   for (const Point& pt : points) {
     INFO(pt.scene << " " << pt.p_W.transpose());
     auto sim = scenes::LoadScene(pt.scene, config);
     const fovea::IdrResult idr = fovea::RunIdr(sim->rig(), {});
     const fovea::Nl1Matcher matcher;
-    const fovea::FixationResult r = fovea::Fixate(sim->rig(), idr.map, pt.p_W, matcher, {});
+    const fovea::FixationResult r =
+        fovea::Fixate(sim->rig(), idr.map, pt.p_W, matcher, fovea::ResolvedFixationOptions({}));
     REQUIRE(r.ok);
     const experiments::FovealScore s = experiments::ScoreFoveal(r, sim->truth());
     REQUIRE(s.levels.size() >= 2);
@@ -47,10 +49,10 @@ TEST_CASE("where the map is silent, a surface outside Z_T gives no false patches
   // 0.50-0.56 m lie far outside Z_T, and the paper's search of the Z_T band
   // takes false matches of their grain for surfaces in the band.
   sim::SimRigConfig config;
-  config.noise.read_noise_sigma_dn = 2.0;
+  config.noise.read_noise_sigma_dn = experiments::kExperimentNoiseSigmaDn;
   auto gross = [&](double silent_near_m) {
     auto sim = scenes::LoadScene("three_surfaces", config);
-    fovea::FixationOptions o;
+    fovea::FixationOptions o = fovea::ResolvedFixationOptions({});  // the run's
     o.baseline_m = 0.12;         // Z_T about -0.15 / +0.2 m around 1.2 m: the blocks far outside it
     o.choose_placement = false;  // carriages symmetric, as measured
     o.foveal.silent_near_m = silent_near_m;

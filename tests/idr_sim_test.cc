@@ -2,6 +2,7 @@
 // ground truth. Slow: labelled [slow].
 #include <catch2/catch.hpp>
 
+#include "experiments/config/config.h"
 #include "experiments/scoring/idr_eval.h"
 #include "scenes/catalog.h"
 
@@ -14,7 +15,7 @@ struct Run {
 
 Run RunOn(const std::string& scene, const fovea::IdrOptions& options = {}) {
   sim::SimRigConfig config;
-  config.noise.read_noise_sigma_dn = 2.0;
+  config.noise.read_noise_sigma_dn = experiments::kExperimentNoiseSigmaDn;
   config.seed = 11;
   auto sim = scenes::LoadScene(scene, config);
   Run r;

@@ -30,10 +30,10 @@ TEST_CASE("left camera pair: two grabs of the left camera, the right camera left
     const Eigen::Isometry3d expected =
         rig.Geometry().WorldFromCamera(rig::Side::kLeft, target[side]);
     CHECK((f[side].world_T_camera.translation() - expected.translation()).norm() < 1e-4);
-    CHECK(f.state[side].baseline_m == Approx(target[side].baseline_m).margin(1e-5));
+    CHECK(f.state[side].carriage_m == Approx(target[side].carriage_m).margin(1e-5));
   }
-  CHECK(rig.State().left.baseline_m == Approx(-0.11).margin(1e-5));
-  CHECK(rig.State().right.baseline_m == Approx(before.right.baseline_m).margin(1e-5));
+  CHECK(rig.State().left.carriage_m == Approx(-0.11).margin(1e-5));
+  CHECK(rig.State().right.carriage_m == Approx(before.right.carriage_m).margin(1e-5));
   CHECK(pair.Geometry().right.optical_centre_H == rig.Geometry().left.optical_centre_H);
 
   // The "right" image is what the left camera sees from there.
@@ -47,9 +47,9 @@ TEST_CASE("left camera pair: two grabs of the left camera, the right camera left
 
   // A stage the left carriage cannot reach is refused before anything moves.
   rig::StageState bad = target;
-  bad.right.baseline_m = 0.05;
+  bad.right.carriage_m = 0.05;
   const rig::StageState still = rig.State();
   CHECK_THROWS_AS(pair.MoveTo(bad), rig::RigError);
-  CHECK(rig.State().left.baseline_m == Approx(still.left.baseline_m).margin(1e-6));
+  CHECK(rig.State().left.carriage_m == Approx(still.left.carriage_m).margin(1e-6));
   CHECK_THROWS_AS(pair.Capture({true}), rig::RigError);
 }

@@ -50,18 +50,18 @@ TEST_CASE("carriage placements keep the baseline and put the named carriage inne
   const fovea::PlacementRig l = TestRig();
   using fovea::Placement;
   const rig::StageState sym = fovea::PlaceCarriages(l, kBaseline, Placement::kSymmetric);
-  CHECK(sym.left.baseline_m == Approx(-0.03));
-  CHECK(sym.right.baseline_m == Approx(0.03));
+  CHECK(sym.left.carriage_m == Approx(-0.03));
+  CHECK(sym.right.carriage_m == Approx(0.03));
   const rig::StageState ri = fovea::PlaceCarriages(l, kBaseline, Placement::kRightInner);
-  CHECK(ri.right.baseline_m == Approx(0.0005));
-  CHECK(ri.left.baseline_m == Approx(-0.0595));
+  CHECK(ri.right.carriage_m == Approx(0.0005));
+  CHECK(ri.left.carriage_m == Approx(-0.0595));
   const rig::StageState li = fovea::PlaceCarriages(l, kBaseline, Placement::kLeftInner);
-  CHECK(li.left.baseline_m == Approx(-0.0005));
-  CHECK(li.right.baseline_m == Approx(0.0595));
+  CHECK(li.left.carriage_m == Approx(-0.0005));
+  CHECK(li.right.carriage_m == Approx(0.0595));
   // The left camera pair: its right stage at the home pose's left carriage.
   const rig::StageState lp = fovea::PlaceCarriages(l, kBaseline, Placement::kLeftPair);
-  CHECK(lp.right.baseline_m == Approx(-0.05));
-  CHECK(lp.left.baseline_m == Approx(-0.11));
+  CHECK(lp.right.carriage_m == Approx(-0.05));
+  CHECK(lp.left.carriage_m == Approx(-0.11));
   CHECK(l.For(Placement::kLeftPair).limits.Violation(lp).empty());
   CHECK_FALSE(l.limits.Violation(lp).empty());  // no place for the real right camera
   for (const rig::StageState& s : {sym, ri, li, lp}) CHECK(s.BaselineM() == Approx(kBaseline));
@@ -78,7 +78,7 @@ TEST_CASE("placement: the right carriage innermost unless the map hides the poin
   REQUIRE(free.vergence.ok);
   CHECK(free.placement == fovea::Placement::kRightInner);
   CHECK(free.occluded == 0);
-  CHECK(free.vergence.state.right.baseline_m == Approx(0.0005).margin(1e-5));
+  CHECK(free.vergence.state.right.carriage_m == Approx(0.0005).margin(1e-5));
 
   // A 1 cm square halfway along the right camera's line of sight from there:
   // the symmetric placement's cameras look past it (1.5 cm to either side).
@@ -146,7 +146,7 @@ TEST_CASE(
   REQUIRE(with.vergence.ok);
   CHECK(with.placement == fovea::Placement::kLeftPair);
   CHECK(with.occluded == 0);
-  CHECK(with.vergence.state.right.baseline_m == Approx(-0.05).margin(1e-5));
+  CHECK(with.vergence.state.right.carriage_m == Approx(-0.05).margin(1e-5));
   // Both of its "cameras" are the left head: on the point's line of sight
   // from either stage.
   const Eigen::Vector3d a = OpticalCentre(with, rig::Side::kLeft),

@@ -37,8 +37,8 @@ TEST_CASE("projection and back-projection are inverse, with and without distorti
 
 TEST_CASE("stage state helpers", "[rig]") {
   const auto s = rig::StageState::Parallel(0.12);
-  CHECK(s.left.baseline_m == Approx(-0.06));
-  CHECK(s.right.baseline_m == Approx(0.06));
+  CHECK(s.left.carriage_m == Approx(-0.06));
+  CHECK(s.right.carriage_m == Approx(0.06));
   CHECK(s.BaselineM() == Approx(0.12));
   const std::array<double, 6> v = {-0.1, 0.2, -0.3, 0.15, -0.05, 0.01};
   CHECK(rig::StageState::FromArray(v).ToArray() == v);
@@ -54,10 +54,10 @@ TEST_CASE("limits: quantization to whole steps and range checks", "[rig]") {
   }
   rig::StageState s;
   s.left.pan_rad = 0.1234567 * M_PI / 180;  // 790.12 steps
-  s.right.baseline_m = 0.0123456;           // 4938.24 steps
+  s.right.carriage_m = 0.0123456;           // 4938.24 steps
   const rig::StageState q = limits.Quantize(s);
   CHECK(q.left.pan_rad * per_rad == Approx(790).margin(1e-9));
-  CHECK(q.right.baseline_m * per_m == Approx(4938).margin(1e-9));
+  CHECK(q.right.carriage_m * per_m == Approx(4938).margin(1e-9));
   const auto steps = limits.ToSteps(s);
   CHECK(steps[1] == 790);
   CHECK(steps[3] == 4938);

@@ -38,7 +38,8 @@ TEST_CASE("each criterion is normalized and says what it should", "[fovea][selec
   c.has_fixation = true;
   c.fixation_depth_m = 1.0;
   c.z_t_near_m = c.z_t_far_m = 0.1;
-  for (const auto& criterion : fovea::FixationSelector::DefaultCriteria()) {
+  const fovea::CriteriaOptions o;  // the run's
+  for (const auto& criterion : o.Make()) {
     INFO(criterion->Name());
     const cv::Mat w = criterion->Evaluate(c);
     CHECK(cv::sum(w)[0] == Approx(1.0));
@@ -46,15 +47,16 @@ TEST_CASE("each criterion is normalized and says what it should", "[fovea][selec
     cv::minMaxLoc(w, &lo);
     CHECK(lo >= 0);
   }
-  const fovea::GradientAttraction gradient;
-  const fovea::LocalSuppression suppression(0.02, 0.0);
-  const fovea::Proximity2D p2d(40);
-  const fovea::Proximity3D p3d(0.1);
+  const fovea::GradientAttraction gradient(o);
+  const fovea::LocalSuppression suppression(o);
+  const fovea::Proximity2D p2d(o);
+  const fovea::Proximity3D p3d(o);
   CHECK(gradient.Evaluate(c).at<double>(60, 120) > 20 * gradient.Evaluate(c).at<double>(60, 30));
   CHECK(suppression.Evaluate(c).at<double>(60, 120) ==
-        Approx(50 * suppression.Evaluate(c).at<double>(60, 30)));
+        Approx(suppression.Evaluate(c).at<double>(60, 30) / o.suppressed_weight));
   CHECK(p2d.Evaluate(c).at<double>(60, 80) > p2d.Evaluate(c).at<double>(5, 5));
-  CHECK(p3d.Evaluate(c).at<double>(60, 30) == Approx(10 * p3d.Evaluate(c).at<double>(60, 120)));
+  CHECK(p3d.Evaluate(c).at<double>(60, 30) ==
+        Approx(p3d.Evaluate(c).at<double>(60, 120) / o.proximity_3d_low));
 }
 
 TEST_CASE("the exponential draw favours high values with the scale asked for",
@@ -78,7 +80,7 @@ TEST_CASE("selection: deterministic takes the maximum, and draws are reproducibl
   const fovea::SelectionContext c = fovea::SelectionContext::Make(HalfTextured(), View(), map);
   fovea::SelectionOptions o;
   o.deterministic = true;
-  const fovea::FixationSelector det(fovea::FixationSelector::DefaultCriteria(), o);
+  const fovea::FixationSelector det(fovea::CriteriaOptions{}.Make(), o);
   std::mt19937_64 rng(1);
   const auto s = det.Choose(c, map, {}, &rng);
   REQUIRE(s.ok);
@@ -87,7 +89,7 @@ TEST_CASE("selection: deterministic takes the maximum, and draws are reproducibl
   CHECK(s.point_W.y() == Approx(1.0).margin(1e-9));  // raytraced into the map
 
   o.deterministic = false;
-  const fovea::FixationSelector drawn(fovea::FixationSelector::DefaultCriteria(), o);
+  const fovea::FixationSelector drawn(fovea::CriteriaOptions{}.Make(), o);
   std::mt19937_64 a(7), b(7), other(8);
   std::vector<Eigen::Vector2d> pa, pb, po;
   for (int i = 0; i < 10; ++i) {
@@ -112,11 +114,13 @@ TEST_CASE("graded suppression: peripheral data weighs between foveal data and th
   map.Add(Square(0.3, 1, -1, 1, 1.0, fovea::PatchLevel::kIdr));
   const fovea::SelectionContext c = fovea::SelectionContext::Make(HalfTextured(), View(), map);
   // Columns: foveal at x = 10, peripheral at x = 80, IDR at x = 150 (f = 150, 1 m away).
-  const cv::Mat graded = fovea::LocalSuppression(0.02, 0.0, 0.3).Evaluate(c);
+  fovea::CriteriaOptions o;  // the run's: peripheral 0.3, foveal 0.02
+  const cv::Mat graded = fovea::LocalSuppression(o).Evaluate(c);
   CHECK(graded.at<double>(60, 80) == Approx(0.3 * graded.at<double>(60, 150)));
   CHECK(graded.at<double>(60, 10) == Approx(0.02 * graded.at<double>(60, 150)));
   // The paper's rule: peripheral data is not suppressed.
-  const cv::Mat paper = fovea::LocalSuppression(0.02, 0.0, 1.0).Evaluate(c);
+  o.peripheral_weight = 1.0;
+  const cv::Mat paper = fovea::LocalSuppression(o).Evaluate(c);
   CHECK(paper.at<double>(60, 80) == Approx(paper.at<double>(60, 150)));
 }
 
@@ -127,8 +131,10 @@ TEST_CASE("local suppression: zero weight at earlier fixations, low weight aroun
   map.Add(Square(0, 1, -1, 1, 1.0, fovea::PatchLevel::kIdr));      // right half IDR, 1 m
   fovea::SelectionContext c = fovea::SelectionContext::Make(HalfTextured(), View(), map);
   // f = 150 px, 1 m away: pixel column x lies at (x - 80) / 150 m.
-  c.fixated_W = {Eigen::Vector3d(40.0 / 150, 1.0, 0.0), Eigen::Vector3d(-40.0 / 150, 1.0, 0.0)};
-  const cv::Mat w = fovea::LocalSuppression(0.02, 0.08, 0.3, 0.03).Evaluate(c);
+  const Eigen::Vector3d a(40.0 / 150, 1.0, 0.0), b(-40.0 / 150, 1.0, 0.0);
+  c.visits = {{a, a}, {b, b}};
+  fovea::CriteriaOptions o;  // the run's: 0.02, 8 cm, peripheral 0.3, revisit 3 cm
+  const cv::Mat w = fovea::LocalSuppression(o).Evaluate(c);
   const double free = w.at<double>(60, 150);  // 0.2 m from the nearest fixation
   REQUIRE(free > 0);
   CHECK(w.at<double>(60, 120) == 0.0);                  // on the IDR fixation point
@@ -137,8 +143,20 @@ TEST_CASE("local suppression: zero weight at earlier fixations, low weight aroun
   CHECK(w.at<double>(60, 40) == 0.0);                   // foveal data is 0 at a fixation too
   CHECK(w.at<double>(60, 10) == Approx(0.02 * free));   // and 0.02 elsewhere
   // Without a revisit radius the fixation point itself keeps the low weight.
-  const cv::Mat paper = fovea::LocalSuppression(0.02, 0.08, 0.3, 0.0).Evaluate(c);
+  o.revisit_radius_m = 0;
+  const cv::Mat paper = fovea::LocalSuppression(o).Evaluate(c);
   CHECK(paper.at<double>(60, 120) == Approx(0.02 * paper.at<double>(60, 150)));
+  // A point aimed at where the servo settled 20 cm away is suppressed too;
+  // one where it settled 2 cm away adds nothing beyond the settled point.
+  o.revisit_radius_m = 0.03;
+  const Eigen::Vector3d settled(40.0 / 150, 1.0, 0.0), far_aim(70.0 / 150, 1.0, 0.0);
+  c.visits = {{settled, far_aim}};
+  const cv::Mat aimed = fovea::LocalSuppression(o).Evaluate(c);
+  CHECK(aimed.at<double>(60, 150) == 0.0);  // on the point aimed at
+  c.visits = {{settled, Eigen::Vector3d(43.0 / 150, 1.0, 0.0)}};
+  const cv::Mat near_aim = fovea::LocalSuppression(o).Evaluate(c);
+  c.visits = {{settled, settled}};
+  CHECK(cv::norm(near_aim, fovea::LocalSuppression(o).Evaluate(c), cv::NORM_INF) == 0.0);
 }
 
 TEST_CASE("holes in the map take the nearest mapped depth and can be fixated",
@@ -155,7 +173,7 @@ TEST_CASE("holes in the map take the nearest mapped depth and can be fixated",
 
   fovea::SelectionOptions o;
   o.deterministic = true;
-  const fovea::FixationSelector selector(fovea::FixationSelector::DefaultCriteria(), o);
+  const fovea::FixationSelector selector(fovea::CriteriaOptions{}.Make(), o);
   std::mt19937_64 rng(1);
   // Without filling, only the untextured mapped half can be chosen.
   const auto s_plain = selector.Choose(plain, map, {}, &rng);

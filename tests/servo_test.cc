@@ -6,6 +6,7 @@
 #include <memory>
 #include <string>
 
+#include "experiments/config/config.h"
 #include "fovea/foveal.h"
 #include "fovea/geometry.h"
 #include "fovea/vergence.h"
@@ -16,7 +17,7 @@ namespace {
 // A catalog scene with sensor noise on (2 grey levels).
 std::unique_ptr<sim::Simulation> NoisyScene(const std::string& name) {
   sim::SimRigConfig config;
-  config.noise.read_noise_sigma_dn = 2.0;
+  config.noise.read_noise_sigma_dn = experiments::kExperimentNoiseSigmaDn;
   return scenes::LoadScene(name, config);
 }
 
@@ -86,7 +87,7 @@ TEST_CASE("a guessed depth: the servo searches every depth and finds the surface
   // depth, as a hole's nearest mapped neighbour would have it): at a 0.12 m
   // baseline about 170 px of disparity, far beyond the +-40 px of the
   // ordinary search.
-  fovea::FixationOptions o;
+  fovea::FixationOptions o = fovea::ResolvedFixationOptions({});  // the run's
   o.baseline_m = 0.12;
   o.choose_placement = false;  // the symmetric carriages OnLeftAxis assumes
   const Eigen::Vector3d block(-0.11, 0.50, -0.055);
@@ -111,7 +112,7 @@ TEST_CASE("a guessed depth on a periodic texture: no unique match, the point is 
   const fovea::PatchMap empty;
   // The stripes (period about 21 px) at 0.9 m, guessed at 0.6 m: every
   // period in the search matches as well as the true one.
-  fovea::FixationOptions o;
+  fovea::FixationOptions o = fovea::ResolvedFixationOptions({});  // the run's
   o.choose_placement = false;  // the symmetric carriages OnLeftAxis assumes
   const Eigen::Vector3d guess = OnLeftAxis(rig, {0.0, 0.9, 0.0}, 2.0 / 3.0, o.baseline_m);
   const fovea::FixationResult r = fovea::Fixate(rig, empty, guess, matcher, o, 0, kEveryDepth);
@@ -131,7 +132,7 @@ TEST_CASE(
   // deep): the left camera sees it past the edge, the right camera, 6 cm
   // to the right, sees the fabric in front of it.
   const Eigen::Vector3d hidden(-0.10, 1.2, 0.0);
-  fovea::FixationOptions o;
+  fovea::FixationOptions o = fovea::ResolvedFixationOptions({});  // the run's
   o.choose_placement = false;  // symmetric carriages: the right camera's view is blocked
   SECTION("without the check the servo settles on another surface") {
     o.servo.mutual_tolerance_px = 0;

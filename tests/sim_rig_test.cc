@@ -95,7 +95,7 @@ TEST_CASE("moves are quantized to whole steps, settle, and take physical time", 
 
   rig::StageState target = rig.Home();
   target.left.pan_rad = 0.3 * pan_step + 12345 * pan_step;  // between two steps
-  target.right.baseline_m = 0.0712345;
+  target.right.carriage_m = 0.0712345;
   const rig::StageState command = limits.Quantize(target);
   const rig::MoveResult small = rig.MoveTo(target);
   // Settled within one step of the quantized command, not of the raw target.
@@ -107,7 +107,7 @@ TEST_CASE("moves are quantized to whole steps, settle, and take physical time", 
 
   // A long move takes longer than a short one, and a null move takes no time.
   target.left.pan_rad = -40 * kDeg;
-  target.right.baseline_m = 0.28;
+  target.right.carriage_m = 0.28;
   const rig::MoveResult big = rig.MoveTo(target);
   CHECK(big.motion_time_s > small.motion_time_s);
   CHECK(big.motion_time_s < 10);
@@ -127,7 +127,7 @@ TEST_CASE("a move outside the axis limits is refused before anything moves", "[s
     CHECK(std::string(e.what()).find("right pan") != std::string::npos);
   }
   bad = rig.Home();
-  bad.left.baseline_m = 0.01;  // the left carriage stays left of the centre
+  bad.left.carriage_m = 0.01;  // the left carriage stays left of the centre
   CHECK_THROWS_AS(rig.MoveTo(bad), rig::RigError);
   CHECK(rig.State().ToArray() == before.ToArray());
 }

@@ -21,7 +21,7 @@ TEST_CASE("vergence puts the point on both optical axes despite the centre offse
       const auto uv = fovea::ProjectWorldPoint(g.WorldFromCamera(side, sol.state[side]), k, p);
       REQUIRE(uv);
       CHECK((*uv - Eigen::Vector2d(k.cx_px, k.cy_px)).norm() < 0.01);
-      CHECK(sol.state[side].baseline_m == base[side].baseline_m);
+      CHECK(sol.state[side].carriage_m == base[side].carriage_m);
     }
     // The naive atan2 (offset ignored) would miss by pixels: the Newton
     // steps matter.

@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 #include <random>
 
+#include "experiments/config/config.h"
 #include "experiments/output/output.h"
 #include "scenes/catalog.h"
 
@@ -27,6 +28,70 @@ std::vector<std::string> Glob(const std::string& pattern) {
   return files;
 }
 
+namespace {
+
+// An image of a calibration set, grey, of the set's size (the first
+// image's); throws UsageError naming the file.
+cv::Mat ReadBoardImage(const std::string& file, cv::Size* size) {
+  rig::CheckInputFile(file, "calibrate: image");
+  const cv::Mat img = cv::imread(file, cv::IMREAD_GRAYSCALE);
+  if (img.empty())
+    throw UsageError("calibrate: cannot read image '" + rig::ClipForMessage(file) + "'");
+  if (size->empty()) *size = img.size();
+  if (img.size() != *size)
+    throw UsageError("calibrate: '" + rig::ClipForMessage(file) + "' is " +
+                     std::to_string(img.cols) + "x" + std::to_string(img.rows) +
+                     ", the first image is " + std::to_string(size->width) + "x" +
+                     std::to_string(size->height));
+  return img;
+}
+
+// The board's inner corners: the sector-based detector first (robust to
+// noise, sub-pixel accurate), the classic one with sub-pixel refinement as a
+// fallback.
+bool FindBoard(const cv::Mat& img, const cv::Size& pattern, std::vector<cv::Point2f>* corners) {
+  if (cv::findChessboardCornersSB(img, pattern, *corners, cv::CALIB_CB_ACCURACY)) return true;
+  if (!cv::findChessboardCorners(img, pattern, *corners,
+                                 cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE))
+    return false;
+  cv::cornerSubPix(img, *corners, cv::Size(5, 5), cv::Size(-1, -1),
+                   cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 1e-4));
+  return true;
+}
+
+// A board with more corners than --board says holds sub-patterns of the
+// stated size that the detectors find too (left and right may pick different
+// ones): the sector detector, allowed a larger board, reports the size it
+// sees. Throws UsageError naming the file.
+void CheckBoardSize(const cv::Mat& img, const cv::Size& pattern, const std::string& file) {
+  std::vector<cv::Point2f> all;
+  cv::Mat meta;
+  if (!cv::findChessboardCornersSB(img, pattern, all, cv::CALIB_CB_LARGER, meta) ||
+      meta.total() <= static_cast<size_t>(pattern.area()))
+    return;
+  const bool same_way = (pattern.width >= pattern.height) == (meta.cols >= meta.rows);
+  const int seen_cols = same_way ? meta.cols : meta.rows,
+            seen_rows = same_way ? meta.rows : meta.cols;
+  throw UsageError("calibrate: '" + rig::ClipForMessage(file) + "' shows a board of " +
+                   std::to_string(seen_cols) + "x" + std::to_string(seen_rows) +
+                   " inner corners, not the " + std::to_string(pattern.width) + "x" +
+                   std::to_string(pattern.height) + " of --board: count the inner corners again");
+}
+
+rig::CameraIntrinsics IntrinsicsOf(const cv::Mat& k, const cv::Mat& dist, const cv::Size& size) {
+  rig::CameraIntrinsics ki;
+  ki.width_px = size.width;
+  ki.height_px = size.height;
+  ki.fx_px = k.at<double>(0, 0);
+  ki.fy_px = k.at<double>(1, 1);
+  ki.cx_px = k.at<double>(0, 2);
+  ki.cy_px = k.at<double>(1, 2);
+  ki.distortion.assign(dist.begin<double>(), dist.end<double>());
+  return ki;
+}
+
+}  // namespace
+
 CalibrationResult CalibrateStereo(const std::vector<std::string>& left_files,
                                   const std::vector<std::string>& right_files, int cols, int rows,
                                   double square_m) {
@@ -43,63 +108,24 @@ CalibrationResult CalibrateStereo(const std::vector<std::string>& left_files,
       board.emplace_back(float(c * square_m), float(r * square_m), 0.f);
   CalibrationResult result;
   std::vector<std::vector<cv::Point3f>> object;
-  std::vector<std::vector<cv::Point2f>> left_points, right_points;
+  std::vector<std::vector<cv::Point2f>> points[2];
   cv::Size size;
   for (size_t i = 0; i < left_files.size(); ++i) {
+    const std::string* files[2] = {&left_files[i], &right_files[i]};
     std::vector<cv::Point2f> corners[2];
     cv::Mat img[2];
     bool found = true;
     for (int s = 0; s < 2; ++s) {
-      const std::string& file = s == 0 ? left_files[i] : right_files[i];
-      rig::CheckInputFile(file, "calibrate: image");
-      img[s] = cv::imread(file, cv::IMREAD_GRAYSCALE);
-      if (img[s].empty())
-        throw UsageError("calibrate: cannot read image '" + rig::ClipForMessage(file) + "'");
-      if (size.empty()) size = img[s].size();
-      if (img[s].size() != size)
-        throw UsageError("calibrate: '" + rig::ClipForMessage(file) + "' is " +
-                         std::to_string(img[s].cols) + "x" + std::to_string(img[s].rows) +
-                         ", the first image is " + std::to_string(size.width) + "x" +
-                         std::to_string(size.height));
-      // The sector-based detector first (robust to noise, sub-pixel
-      // accurate), the classic one with sub-pixel refinement as a fallback.
-      if (!found) continue;
-      if (!cv::findChessboardCornersSB(img[s], pattern, corners[s], cv::CALIB_CB_ACCURACY)) {
-        found =
-            cv::findChessboardCorners(img[s], pattern, corners[s],
-                                      cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE);
-        if (found)
-          cv::cornerSubPix(
-              img[s], corners[s], cv::Size(5, 5), cv::Size(-1, -1),
-              cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 1e-4));
-      }
+      img[s] = ReadBoardImage(*files[s], &size);
+      found = found && FindBoard(img[s], pattern, &corners[s]);
     }
     if (!found) {
       result.skipped.push_back(left_files[i]);
       continue;
     }
-    // A board with more corners than --board says holds sub-patterns of the
-    // stated size that the detectors find too (left and right may pick
-    // different ones): the sector detector, allowed a larger board, reports
-    // the size it sees.
-    for (int s = 0; s < 2; ++s) {
-      std::vector<cv::Point2f> all;
-      cv::Mat meta;
-      if (cv::findChessboardCornersSB(img[s], pattern, all, cv::CALIB_CB_LARGER, meta) &&
-          meta.total() > static_cast<size_t>(cols) * rows) {
-        const bool same_way = (cols >= rows) == (meta.cols >= meta.rows);
-        const int seen_cols = same_way ? meta.cols : meta.rows,
-                  seen_rows = same_way ? meta.rows : meta.cols;
-        throw UsageError(
-            "calibrate: '" + rig::ClipForMessage(s == 0 ? left_files[i] : right_files[i]) +
-            "' shows a board of " + std::to_string(seen_cols) + "x" + std::to_string(seen_rows) +
-            " inner corners, not the " + std::to_string(cols) + "x" + std::to_string(rows) +
-            " of --board: count the inner corners again");
-      }
-    }
+    for (int s = 0; s < 2; ++s) CheckBoardSize(img[s], pattern, *files[s]);
     object.push_back(board);
-    left_points.push_back(corners[0]);
-    right_points.push_back(corners[1]);
+    for (int s = 0; s < 2; ++s) points[s].push_back(corners[s]);
   }
   result.views = static_cast<int>(object.size());
   if (result.views < 3)
@@ -108,24 +134,15 @@ CalibrationResult CalibrateStereo(const std::vector<std::string>& left_files,
                      " image pairs (need 3 or more)");
   cv::Mat k[2], dist[2];
   std::vector<cv::Mat> rvecs, tvecs;
-  result.rms_left_px = cv::calibrateCamera(object, left_points, size, k[0], dist[0], rvecs, tvecs);
-  result.rms_right_px =
-      cv::calibrateCamera(object, right_points, size, k[1], dist[1], rvecs, tvecs);
+  result.rms_left_px = cv::calibrateCamera(object, points[0], size, k[0], dist[0], rvecs, tvecs);
+  result.rms_right_px = cv::calibrateCamera(object, points[1], size, k[1], dist[1], rvecs, tvecs);
   cv::Mat e, f;
   result.rms_stereo_px =
-      cv::stereoCalibrate(object, left_points, right_points, k[0], dist[0], k[1], dist[1], size,
+      cv::stereoCalibrate(object, points[0], points[1], k[0], dist[0], k[1], dist[1], size,
                           result.r_right_left, result.t_right_left, e, f, cv::CALIB_FIX_INTRINSIC);
   result.baseline_m = cv::norm(result.t_right_left);
-  for (int s = 0; s < 2; ++s) {
-    rig::CameraIntrinsics& ki = s == 0 ? result.calibration.left : result.calibration.right;
-    ki.width_px = size.width;
-    ki.height_px = size.height;
-    ki.fx_px = k[s].at<double>(0, 0);
-    ki.fy_px = k[s].at<double>(1, 1);
-    ki.cx_px = k[s].at<double>(0, 2);
-    ki.cy_px = k[s].at<double>(1, 2);
-    ki.distortion.assign(dist[s].begin<double>(), dist[s].end<double>());
-  }
+  result.calibration.left = IntrinsicsOf(k[0], dist[0], size);
+  result.calibration.right = IntrinsicsOf(k[1], dist[1], size);
   return result;
 }
 
@@ -152,7 +169,7 @@ SyntheticTruth RenderChessboardViews(const std::string& dir, int views, double s
   };
   SyntheticTruth truth;
   sim::SimRigConfig config;
-  config.noise.read_noise_sigma_dn = 2;  // as the experiments' cameras
+  config.noise.read_noise_sigma_dn = kExperimentNoiseSigmaDn;
   config.seed = seed;
   for (int v = 0; v < views; ++v) {
     char pose[256];

@@ -4,6 +4,8 @@
 
 #include "commands.h"
 #include "experiments/output/output.h"
+#include "fovea/geometry.h"
+#include "fovea/stats.h"
 #include "scene_options.h"
 
 namespace experiments {
@@ -106,100 +108,108 @@ struct BenchFixationArgs {
   bool json = false;
 };
 
-int BenchFixation(const BenchFixationArgs& args) {
+// The whole-frame matchers against the fovea's, on one fixation's frame over
+// the depths the fovea searches (Z_T about the fixation depth), with their
+// disparity errors on the foveal pixels (level 0, unmasked, with truth).
+struct WholeFrame {
+  double full_ms = 0, sgbm_ms = 0;
+  std::vector<double> full_err, sgbm_err;
+  int fovea_pixels = 0;
+  double d_lo = 0, d_hi = 0;
+};
+
+WholeFrame MatchWholeFrame(const fovea::FixationResult& r, const fovea::Nl1Matcher& nl1,
+                           const sim::GroundTruth& truth) {
   using Clock = std::chrono::steady_clock;
   auto ms = [](Clock::time_point t0) {
     return 1e3 * std::chrono::duration<double>(Clock::now() - t0).count();
   };
-  RunConfig config;  // the run's defaults: noise on
-  args.scene.ApplyTo(&config);
-  const Eigen::Vector3d p(*ParseNumber(args.point[0]), *ParseNumber(args.point[1]),
-                          *ParseNumber(args.point[2]));
-  auto sim = LoadSceneOf(config);
-  rig::Rig& rig = sim->rig();
-  const fovea::IdrResult idr = fovea::RunIdr(rig, {});
-  const fovea::Nl1Matcher nl1;
-  const fovea::FixationResult r = fovea::Fixate(rig, idr.map, p, nl1, {});
-  if (!r.ok) throw std::runtime_error("cannot fixate the benchmark point: " + r.why);
-  const FovealScore score = ScoreFoveal(r, sim->truth());
-  double foveated_ms = 0;
-  for (const auto& level : r.foveal.levels) foveated_ms += 1e3 * level.match_time_s;
-
   const rig::StereoFrame& frame = r.servo.frame;
   const rig::CameraView& left = frame.left;
   const rig::CameraIntrinsics& k = left.intrinsics;
   const fovea::Tessellation& t = r.foveal.tessellation;
   const Eigen::Isometry3d right_T_left = frame.right.world_T_camera.inverse() * left.world_T_camera;
   auto disparity_at = [&](double u, double v, double z) {
-    const Eigen::Vector3d p_R = right_T_left * (z * k.Ray({u, v}));
-    return u - (frame.right.intrinsics.fx_px * p_R.x() / p_R.z() + frame.right.intrinsics.cx_px);
+    return fovea::DisparityAtDepth(left, frame.right, right_T_left, u, v, z);
   };
-  // The same depth range the fovea searches: Z_T about the fixation depth.
+  WholeFrame w;
   const double z_near = t.fixation_depth_m - t.z_t_near_m, z_far = t.fixation_depth_m + t.z_t_far_m;
-  const double d_lo = disparity_at(k.cx_px, k.cy_px, z_far),
-               d_hi = disparity_at(k.cx_px, k.cy_px, z_near);
-
-  // Full-resolution NL1 over the whole frame.
+  w.d_lo = std::min(disparity_at(k.cx_px, k.cy_px, z_far), disparity_at(k.cx_px, k.cy_px, z_near));
+  w.d_hi = std::max(disparity_at(k.cx_px, k.cy_px, z_far), disparity_at(k.cx_px, k.cy_px, z_near));
   auto t0 = Clock::now();
-  const fovea::DisparityMap full =
-      nl1.Match(left.gray, frame.right.gray,
-                cv::Mat(left.gray.size(), CV_32F, cv::Scalar(std::min(d_lo, d_hi) - 1)),
-                cv::Mat(left.gray.size(), CV_32F, cv::Scalar(std::max(d_lo, d_hi) + 1)));
-  const double full_ms = ms(t0);
-  // StereoSGBM on the rectified full frame.
+  const fovea::DisparityMap full = nl1.Match(
+      left.gray, frame.right.gray, cv::Mat(left.gray.size(), CV_32F, cv::Scalar(w.d_lo - 1)),
+      cv::Mat(left.gray.size(), CV_32F, cv::Scalar(w.d_hi + 1)));
+  w.full_ms = ms(t0);
   t0 = Clock::now();
   const cv::Mat sgbm_depth = fovea::RectifiedSgbmDepth(left, frame.right, z_near, z_far);
-  const double sgbm_ms = ms(t0);
-
-  // Errors on the same foveal pixels (level 0, unmasked, with truth).
-  const cv::Mat truth = sim->truth().RayCastDepth(left.world_T_camera, k);
-  std::vector<double> full_err, sgbm_err;
-  int fovea_pixels = 0;
+  w.sgbm_ms = ms(t0);
+  const cv::Mat true_depth = truth.RayCastDepth(left.world_T_camera, k);
   const cv::Rect& fovea = t.rects[0];
   for (int v = fovea.y; v < fovea.y + fovea.height; ++v)
     for (int u = fovea.x; u < fovea.x + fovea.width; ++u) {
-      const float zt = truth.at<float>(v, u);
+      const float zt = true_depth.at<float>(v, u);
       if (zt <= 0 || !t.mask.at<uchar>(v, u)) continue;
-      ++fovea_pixels;
+      ++w.fovea_pixels;
       const double dt = disparity_at(u, v, zt);
       const float df = full.disparity_px.at<float>(v, u);
-      if (std::isfinite(df)) full_err.push_back(std::abs(df - dt));
+      if (std::isfinite(df)) w.full_err.push_back(std::abs(df - dt));
       const float zs = sgbm_depth.at<float>(v, u);
-      if (zs > 0) sgbm_err.push_back(std::abs(disparity_at(u, v, zs) - dt));
+      if (zs > 0) w.sgbm_err.push_back(std::abs(disparity_at(u, v, zs) - dt));
     }
-  auto median = [](std::vector<double> e) {
-    if (e.empty()) return std::nan("");
-    std::nth_element(e.begin(), e.begin() + e.size() / 2, e.end());
-    return e[e.size() / 2];
+  return w;
+}
+
+int BenchFixation(const BenchFixationArgs& args) {
+  RunConfig config;  // the run's defaults: noise on
+  args.scene.ApplyTo(&config);
+  config.Check();
+  const Eigen::Vector3d p(*ParseNumber(args.point[0]), *ParseNumber(args.point[1]),
+                          *ParseNumber(args.point[2]));
+  auto sim = LoadSceneOf(config);
+  rig::Rig& rig = sim->rig();
+  const fovea::IdrResult idr = fovea::RunIdr(rig, config.fovea.idr);
+  const fovea::Nl1Matcher nl1(config.fovea.nl1);
+  const fovea::FixationResult r =
+      fovea::Fixate(rig, idr.map, p, nl1, fovea::ResolvedFixationOptions(config.fovea));
+  if (!r.ok) throw std::runtime_error("cannot fixate the benchmark point: " + r.why);
+  const FovealScore score = ScoreFoveal(r, sim->truth());
+  double foveated_ms = 0;
+  for (const auto& level : r.foveal.levels) foveated_ms += 1e3 * level.match_time_s;
+  const WholeFrame w = MatchWholeFrame(r, nl1, sim->truth());
+  const fovea::Tessellation& t = r.foveal.tessellation;
+  const cv::Rect& fovea = t.rects[0];
+  auto median = [](const std::vector<double>& e) { return fovea::Quantile(e, 0.5, std::nan("")); };
+  auto share = [&](const std::vector<double>& e) {
+    return w.fovea_pixels ? double(e.size()) / w.fovea_pixels : 0.0;
   };
-  nlohmann::json j = {
-      {"scene", sim->scene_path()},
-      {"fovea_px", {fovea.width, fovea.height}},
-      {"levels", t.rects.size()},
-      {"foveated_ms", foveated_ms},
-      {"full_res_ms", full_ms},
-      {"sgbm_ms", sgbm_ms},
-      {"foveal_error_px", score.levels[0].median_disparity_error_px},
-      {"full_res_error_px", median(full_err)},
-      {"sgbm_error_px", median(sgbm_err)},
-      {"full_res_fovea_coverage", fovea_pixels ? double(full_err.size()) / fovea_pixels : 0.0},
-      {"sgbm_fovea_coverage", fovea_pixels ? double(sgbm_err.size()) / fovea_pixels : 0.0},
-      {"foveal_coverage", score.fovea_coverage},
-      {"disparity_range_px", {std::min(d_lo, d_hi), std::max(d_lo, d_hi)}},
-      {"full_res_over_foveated", full_ms / foveated_ms},
-      {"sgbm_over_foveated", sgbm_ms / foveated_ms}};
+  const nlohmann::json j = {{"scene", sim->scene_path()},
+                            {"fovea_px", {fovea.width, fovea.height}},
+                            {"levels", t.rects.size()},
+                            {"foveated_ms", foveated_ms},
+                            {"full_res_ms", w.full_ms},
+                            {"sgbm_ms", w.sgbm_ms},
+                            {"foveal_error_px", score.levels[0].median_disparity_error_px},
+                            {"full_res_error_px", median(w.full_err)},
+                            {"sgbm_error_px", median(w.sgbm_err)},
+                            {"full_res_fovea_coverage", share(w.full_err)},
+                            {"sgbm_fovea_coverage", share(w.sgbm_err)},
+                            {"foveal_coverage", score.fovea_coverage},
+                            {"disparity_range_px", {w.d_lo, w.d_hi}},
+                            {"full_res_over_foveated", w.full_ms / foveated_ms},
+                            {"sgbm_over_foveated", w.sgbm_ms / foveated_ms}};
   if (args.json) {
     std::printf("%s\n", j.dump().c_str());
-  } else {
-    std::printf("fixation benchmark, %s, fovea %dx%d, %zu levels\n", sim->scene_path().c_str(),
-                fovea.width, fovea.height, t.rects.size());
-    std::printf("  foveated NL1 (all levels)   %8.1f ms   foveal error %.3f px\n", foveated_ms,
-                j["foveal_error_px"].get<double>());
-    std::printf("  full-resolution NL1         %8.1f ms   foveal error %.3f px  (%.1fx the time)\n",
-                full_ms, j["full_res_error_px"].get<double>(), full_ms / foveated_ms);
-    std::printf("  StereoSGBM, rectified frame %8.1f ms   foveal error %.3f px  (%.1fx the time)\n",
-                sgbm_ms, j["sgbm_error_px"].get<double>(), sgbm_ms / foveated_ms);
+    return 0;
   }
+  std::printf("fixation benchmark, %s, fovea %dx%d, %zu levels\n", sim->scene_path().c_str(),
+              fovea.width, fovea.height, t.rects.size());
+  std::printf("  foveated NL1 (all levels)   %8.1f ms   foveal error %.3f px\n", foveated_ms,
+              j["foveal_error_px"].get<double>());
+  std::printf("  full-resolution NL1         %8.1f ms   foveal error %.3f px  (%.1fx the time)\n",
+              w.full_ms, j["full_res_error_px"].get<double>(), w.full_ms / foveated_ms);
+  std::printf("  StereoSGBM, rectified frame %8.1f ms   foveal error %.3f px  (%.1fx the time)\n",
+              w.sgbm_ms, j["sgbm_error_px"].get<double>(), w.sgbm_ms / foveated_ms);
   return 0;
 }
 

@@ -5,7 +5,7 @@
 #include "experiments/output/output.h"
 #include "experiments/output/run_output.h"
 #include "experiments/scoring/foveal_eval.h"
-#include "fovea/idr.h"
+#include "fovea/ddr.h"
 #include "fovea/sgbm.h"
 #include "scene_options.h"
 
@@ -31,13 +31,11 @@ int Fixate(const FixateArgs& args) {
   OutputFolder folder(args.out, "--out", ExistingPolicy(args.force));
   auto sim = LoadSceneOf(config);
   rig::Rig& rig = sim->rig();
-  const fovea::IdrResult idr = fovea::RunIdr(rig, {});
-  std::unique_ptr<fovea::StereoMatcher> matcher;
-  if (config.matcher == "sgbm")
-    matcher = std::make_unique<fovea::SgbmMatcher>();
-  else
-    matcher = std::make_unique<fovea::Nl1Matcher>();
-  const fovea::FixationResult r = fovea::Fixate(rig, idr.map, p, *matcher, config.fovea.fixation);
+  const fovea::IdrResult idr = fovea::RunIdr(rig, config.fovea.idr);
+  const std::unique_ptr<fovea::StereoMatcher> matcher =
+      fovea::MakeMatcher(config.matcher, config.fovea);
+  const fovea::FixationResult r =
+      fovea::Fixate(rig, idr.map, p, *matcher, fovea::ResolvedFixationOptions(config.fovea));
   if (!r.ok) {
     char at[96];
     std::snprintf(at, sizeof at, "(%.3f, %.3f, %.3f)", p.x(), p.y(), p.z());

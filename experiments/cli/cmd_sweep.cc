@@ -19,6 +19,7 @@
 #include "experiments/config/sweep.h"
 #include "experiments/output/output.h"
 #include "experiments/output/report.h"
+#include "experiments/output/run_folder.h"
 
 namespace experiments {
 namespace fs = std::filesystem;
@@ -200,6 +201,49 @@ std::vector<std::string> Finish(const std::string& dir, const nlohmann::json& gr
   return missing;
 }
 
+// Runs `pending` as `jobs` parallel `fovea run` processes into DIR/runs/,
+// with a progress display; on SIGINT/SIGTERM stops them all (g_stop set).
+// Returns the ids of the runs that failed.
+std::vector<std::string> RunPending(const std::string& dir, const std::string& exe,
+                                    const std::vector<const SweepRun*>& pending, int jobs, int done,
+                                    int total) {
+  struct sigaction sa {};
+  sa.sa_handler = OnSignal;
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+  Progress progress(total, done);
+  std::map<pid_t, std::pair<const SweepRun*, Clock::time_point>> running;
+  std::vector<std::string> failed;
+  size_t next = 0;
+  while ((next < pending.size() || !running.empty()) && !g_stop) {
+    while (next < pending.size() && static_cast<int>(running.size()) < jobs && !g_stop) {
+      const SweepRun& r = *pending[next++];
+      const std::string config = dir + "/configs/" + r.id + ".yaml";
+      WriteTextAtomic(config, DumpConfig(r.config));
+      RemoveStaging(dir + "/runs", r.id);
+      running[Spawn(exe, config, dir + "/runs/" + r.id, dir + "/logs/" + r.id + ".log")] = {
+          &r, Clock::now()};
+    }
+    int status = 0;
+    const pid_t pid = waitpid(-1, &status, 0);
+    if (pid < 0) continue;  // interrupted by a signal
+    const auto it = running.find(pid);
+    if (it == running.end()) continue;
+    const SweepRun& r = *it->second.first;
+    const double s = std::chrono::duration<double>(Clock::now() - it->second.second).count();
+    running.erase(it);
+    const bool ok = WIFEXITED(status) && WEXITSTATUS(status) == 0 &&
+                    fs::exists(dir + "/runs/" + r.id + "/" + run_folder::kSummary);
+    if (!ok) failed.push_back(r.id);
+    progress.Finished(r.id, ok, s);
+  }
+  if (g_stop) {
+    for (const auto& [pid, run] : running) kill(pid, SIGTERM);
+    for (const auto& [pid, run] : running) waitpid(pid, nullptr, 0);
+  }
+  return failed;
+}
+
 int RunSweep(const SweepArgs& args) {
   const Sweep sweep = LoadSweep(args.file);
   const auto [shard_i, shard_n] =
@@ -211,7 +255,6 @@ int RunSweep(const SweepArgs& args) {
   const nlohmann::json grid = GridJson(sweep);
   const std::string grid_text = grid.dump(1) + "\n";
   CheckSweepFolder(dir, grid_text, args.resume);
-  const std::string exe = SelfExe();
   EnsureDirectory(dir);
   const SweepLock lock(dir, shard_i, shard_n);
   EnsureDirectory(dir + "/runs");
@@ -241,39 +284,10 @@ int RunSweep(const SweepArgs& args) {
           .c_str(),
       dir.c_str());
 
-  struct sigaction sa {};
-  sa.sa_handler = OnSignal;
-  sigaction(SIGINT, &sa, nullptr);
-  sigaction(SIGTERM, &sa, nullptr);
-  Progress progress(static_cast<int>(mine.size()), static_cast<int>(mine.size() - pending.size()));
-  std::map<pid_t, std::pair<const SweepRun*, Clock::time_point>> running;
-  std::vector<std::string> failed;
-  size_t next = 0;
-  while ((next < pending.size() || !running.empty()) && !g_stop) {
-    while (next < pending.size() && static_cast<int>(running.size()) < jobs && !g_stop) {
-      const SweepRun& r = *pending[next++];
-      const std::string config = dir + "/configs/" + r.id + ".yaml";
-      WriteTextAtomic(config, DumpConfig(r.config));
-      RemoveStaging(dir + "/runs", r.id);
-      running[Spawn(exe, config, dir + "/runs/" + r.id, dir + "/logs/" + r.id + ".log")] = {
-          &r, Clock::now()};
-    }
-    int status = 0;
-    const pid_t pid = waitpid(-1, &status, 0);
-    if (pid < 0) continue;  // interrupted by a signal
-    const auto it = running.find(pid);
-    if (it == running.end()) continue;
-    const SweepRun& r = *it->second.first;
-    const double s = std::chrono::duration<double>(Clock::now() - it->second.second).count();
-    running.erase(it);
-    const bool ok = WIFEXITED(status) && WEXITSTATUS(status) == 0 &&
-                    fs::exists(dir + "/runs/" + r.id + "/summary.json");
-    if (!ok) failed.push_back(r.id);
-    progress.Finished(r.id, ok, s);
-  }
+  const std::vector<std::string> failed =
+      RunPending(dir, SelfExe(), pending, jobs, static_cast<int>(mine.size() - pending.size()),
+                 static_cast<int>(mine.size()));
   if (g_stop) {
-    for (const auto& [pid, run] : running) kill(pid, SIGTERM);
-    for (const auto& [pid, run] : running) waitpid(pid, nullptr, 0);
     std::fprintf(stderr,
                  "\nfovea sweep: stopped by signal %d; the same command with --resume resumes it\n",
                  int(g_stop));

@@ -13,24 +13,16 @@
 #include <set>
 #include <sstream>
 
+#include "fovea/params.h"
+
 namespace experiments {
 namespace {
 
-std::string FormatNumber(double v) {
-  char buf[64];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, r.ptr);
-}
+std::string FormatNumber(double v) { return rig::FormatParamNumber(v); }
 
 std::string Range(const ConfigParam& p) {
-  if (std::holds_alternative<bool*>(p.target)) return "true or false";
-  if (std::holds_alternative<std::string*>(p.target)) {
-    if (p.choices.empty()) return "any text";
-    std::string s = "one of";
-    for (size_t i = 0; i < p.choices.size(); ++i) s += (i ? ", " : " ") + p.choices[i];
-    return s;
-  }
-  return "[" + FormatNumber(p.lo) + ", " + FormatNumber(p.hi) + "]";
+  if (std::holds_alternative<std::string*>(p.target) && !p.spec->choices) return "any text";
+  return rig::RangeText(*p.spec, std::holds_alternative<bool*>(p.target));
 }
 
 // Valid UTF-8 with no control character but tab and newline: the text a
@@ -78,9 +70,11 @@ void Assign(const ConfigParam& p, const std::string& text, const std::string& la
     return;
   }
   if (auto* s = std::get_if<std::string*>(&p.target)) {
-    if (!p.choices.empty() &&
-        std::find(p.choices.begin(), p.choices.end(), text) == p.choices.end())
+    try {
+      rig::CheckParam(*p.spec, text);
+    } catch (const rig::InputError&) {
       fail(shown + " is not " + Range(p));
+    }
     if (!IsPlainText(text))
       fail("expected UTF-8 text without control characters (tabs and newlines aside)");
     **s = text;
@@ -90,14 +84,15 @@ void Assign(const ConfigParam& p, const std::string& text, const std::string& la
   if (!v) fail("expected a number, got " + shown);
   const bool integral = !std::holds_alternative<double*>(p.target);
   if (integral && *v != std::floor(*v)) fail("expected a whole number, got " + shown);
-  if (*v < p.lo || *v > p.hi) fail(rig::ClipForMessage(text) + " is out of range " + Range(p));
+  if (*v < p.spec->lo || *v > p.spec->hi)
+    fail(rig::ClipForMessage(text) + " is out of range " + Range(p));
   // Written as digits, a whole number is compared exactly: a double rounds
   // 2^53 + 1 down to 2^53.
   long long exact = 0;
   const auto digits = std::from_chars(text.data(), text.data() + text.size(), exact);
   if (integral && digits.ptr == text.data() + text.size() &&
-      (digits.ec != std::errc() || exact < static_cast<long long>(p.lo) ||
-       exact > static_cast<long long>(p.hi)))
+      (digits.ec != std::errc() || exact < static_cast<long long>(p.spec->lo) ||
+       exact > static_cast<long long>(p.spec->hi)))
     fail(rig::ClipForMessage(text) + " is out of range " + Range(p));
   if (auto* d = std::get_if<double*>(&p.target))
     **d = *v;
@@ -140,206 +135,193 @@ std::optional<double> ParseNumber(const std::string& text) {
   return v;
 }
 
-std::vector<ConfigParam> ConfigParams(RunConfig* c) {
+namespace {
+
+// The run itself: scene, seed, method, matcher.
+void AddTopParams(RunConfig* c, std::vector<ConfigParam>* params) {
+  namespace ep = params;
+  params->insert(params->end(), {
+                                    {&ep::kScene, &c->scene},
+                                    {&ep::kSeed, &c->seed},
+                                    {&ep::kMethod, &c->method},
+                                    {&ep::kMatcher, &c->matcher},
+                                });
+}
+
+// The rig: the simulated TAVT, the hardware rig, the sensor.
+void AddRigParams(RunConfig* c, std::vector<ConfigParam>* params) {
+  namespace sp = sim::params;
+  namespace ep = params;
+  sim::SimRigConfig& r = c->rig;
+  RunConfig::Hardware& h = c->hardware;
+  params->insert(params->end(), {
+                                    {&sp::kWidthPx, &r.width_px},
+                                    {&sp::kHeightPx, &r.height_px},
+                                    {&sp::kHorizontalFovDeg, &r.horizontal_fov_deg},
+                                    {&sp::kOpticalCentreXM, &r.optical_centre_offset_m.x()},
+                                    {&sp::kOpticalCentreYM, &r.optical_centre_offset_m.y()},
+                                    {&sp::kOpticalCentreZM, &r.optical_centre_offset_m.z()},
+                                    {&sp::kCarriageMinM, &r.carriage_min_m},
+                                    {&sp::kCarriageMaxM, &r.carriage_max_m},
+                                    {&sp::kHomeBaselineM, &r.home_baseline_m},
+                                    {&sp::kPanLimitDeg, &r.pan_limit_deg},
+                                    {&sp::kTiltLimitDeg, &r.tilt_limit_deg},
+                                    {&sp::kBaselineStepsPerMm, &r.baseline_steps_per_mm},
+                                    {&sp::kPanTiltStepsPerDeg, &r.pan_tilt_steps_per_deg},
+                                    {&sp::kSettleToleranceSteps, &r.settle_tolerance_steps},
+                                    {&sp::kMoveTimeoutS, &r.move_timeout_s},
+                                    {&ep::kRigType, &h.type},
+                                    {&ep::kPort, &h.port},
+                                    {&ep::kBaud, &h.baud},
+                                    {&ep::kEmulateStages, &h.emulate_stages},
+                                    {&ep::kUnits, &h.units},
+                                    {&ep::kDirections, &h.directions},
+                                    {&ep::kLeftCamera, &h.left_camera},
+                                    {&ep::kRightCamera, &h.right_camera},
+                                    {&ep::kCalibration, &h.calibration},
+                                    {&ep::kFrameTimeoutS, &h.frame_timeout_s},
+                                    {&ep::kBaselineVelocityMS, &h.baseline_velocity_m_s},
+                                    {&ep::kPanTiltVelocityRadS, &h.pan_tilt_velocity_rad_s},
+                                    {&sp::kRecordDir, &r.record_dir},
+                                    {&sp::kNoiseSigmaDn, &r.noise.read_noise_sigma_dn},
+                                    {&sp::kBlurSigmaPx, &r.noise.blur_sigma_px},
+                                });
+}
+
+// The fixation loop.
+void AddLoopParams(RunConfig* c, std::vector<ConfigParam>* params) {
+  namespace fp = fovea::params;
   fovea::FoveaOptions& f = c->fovea;
-  constexpr double kBig = 1e9;
-  return {
-      {"scene", "catalog scene name or path to an MJCF scene file (empty: cylinder_planes)",
-       &c->scene},
-      {"seed", "the one seed: sensor noise and every fixation draw", &c->seed, 0,
-       9007199254740992.0},
-      {"method",
-       "fovea: the FOVEA loop; static_sgbm: the baseline, StereoSGBM on the static pair at the "
-       "home pose and widest baseline",
-       &c->method,
-       0,
-       0,
-       {"fovea", "static_sgbm"}},
-      {"matcher", "matcher of the foveated stage", &c->matcher, 0, 0, {"nl1", "sgbm"}},
-      {"rig.width_px", "image width, pixels", &c->rig.width_px, 64, 4096},
-      {"rig.height_px", "image height, pixels", &c->rig.height_px, 48, 4096},
-      {"rig.horizontal_fov_deg",
-       "lens: horizontal field of view edge to edge, degrees (16 mm lens: 30)",
-       &c->rig.horizontal_fov_deg, 5, 100},
-      {"rig.carriage_max_m", "baseline axes: each carriage's travel from the rail centre, metres",
-       &c->rig.carriage_max_m, 0.01, 2},
-      {"rig.home_baseline_m", "baseline at the home pose (the reference view's pose), metres",
-       &c->rig.home_baseline_m, 0.002, 4},
-      {"rig.pan_limit_deg", "pan axes: symmetric travel limit, degrees", &c->rig.pan_limit_deg, 1,
-       179},
-      {"rig.tilt_limit_deg", "tilt axes: symmetric travel limit, degrees", &c->rig.tilt_limit_deg,
-       1, 89},
-      {"rig.baseline_steps_per_mm", "baseline axes: motor steps per millimetre",
-       &c->rig.baseline_steps_per_mm, 1, 1e6},
-      {"rig.pan_tilt_steps_per_deg", "pan and tilt axes: motor steps per degree",
-       &c->rig.pan_tilt_steps_per_deg, 1, 1e6},
-      {"rig.type",
-       "sim: the simulated TAVT; hardware: serial stages and cameras (the keys below)",
-       &c->hardware.type,
-       0,
-       0,
-       {"sim", "hardware"}},
-      {"rig.port", "hardware: the stages' serial port (e.g. /dev/ttyUSB0)", &c->hardware.port},
-      {"rig.baud", "hardware: the serial port's baud rate", &c->hardware.baud, 1200, 230400},
-      {"rig.emulate_stages",
-       "hardware: drive the indexer emulator (a pseudo-terminal in this process) instead of "
-       "rig.port",
-       &c->hardware.emulate_stages},
-      {"rig.units",
-       "hardware: indexer unit addresses of the six axes (left baseline, pan, tilt, right "
-       "baseline, pan, tilt)",
-       &c->hardware.units},
-      {"rig.directions",
-       "hardware: motor direction of each axis against the rig's convention, +1 or -1, same order",
-       &c->hardware.directions},
-      {"rig.left_camera",
-       "hardware: left camera: V4L2 index or path, video file, or image sequence "
-       "(rec/left_%05d.png)",
-       &c->hardware.left_camera},
-      {"rig.right_camera", "hardware: right camera, as rig.left_camera", &c->hardware.right_camera},
-      {"rig.calibration", "hardware: calibration file (fovea calibrate, or OpenCV YAML by hand)",
-       &c->hardware.calibration},
-      {"rig.frame_timeout_s", "hardware: longest wait for a camera frame, seconds",
-       &c->hardware.frame_timeout_s, 0.01, 60},
-      {"rig.baseline_velocity_m_s",
-       "hardware: baseline axes' speed, metres per second (acceleration 10x per second)",
-       &c->hardware.baseline_velocity_m_s, 1e-4, 1},
-      {"rig.pan_tilt_velocity_rad_s",
-       "hardware: pan and tilt axes' speed, radians per second (acceleration 10x per second)",
-       &c->hardware.pan_tilt_velocity_rad_s, 1e-3, 10},
-      {"rig.record_dir",
-       "sim: also write every capture to this folder (left_NNNNN.png, right_NNNNN.png) for replay",
-       &c->rig.record_dir},
-      {"rig.noise_sigma_dn", "sensor read noise, grey levels (0 = off)",
-       &c->rig.noise.read_noise_sigma_dn, 0, 50},
-      {"rig.blur_sigma_px", "optical blur before the noise, pixels (0 = off)",
-       &c->rig.noise.blur_sigma_px, 0, 10},
-      {"loop.fixations", "successful fixations to make", &f.fixations, 1, 10000},
-      {"loop.stay_in_idr_view", "fixate only points inside the IDR view (the region the run maps)",
-       &f.stay_in_idr_view},
-      {"loop.fixate_holes",
-       "beyond the paper: pixels the map is silent at are candidates, at the depth of the nearest "
-       "mapped pixel (false: the paper's rule)",
-       &f.fixate_holes},
-      {"loop.stall_fixations",
-       "stop when the foveal share grew by less than stall_growth over this many fixations (0 = "
-       "never)",
-       &f.stall_fixations, 0, 10000},
-      {"loop.stall_growth", "see stall_fixations (share of the IDR view)", &f.stall_growth, 0, 1},
-      {"loop.attempts_per_fixation",
-       "attempt budget per fixation wanted (points that cannot be fixated)",
-       &f.attempts_per_fixation, 1, 100},
-      {"idr.log_sigma_px", "LoG scale of the zero crossings, pixels",
-       &f.idr.zero_crossings.sigma_px, 1, 8},
-      {"idr.unique_share", "share of zero crossings kept unambiguous at the initial baseline",
-       &f.idr.unique_share, 0.5, 1},
-      {"idr.z_min_m", "nearest scene distance, metres", &f.idr.z_min_m, 0.05, 10},
-      {"idr.max_slant_deg", "largest surface slant for the expansion factor, degrees",
-       &f.idr.max_slant_deg, 0, 89},
-      {"idr.max_expansion", "cap on the baseline expansion factor per stage", &f.idr.max_expansion,
-       1.1, 16},
-      {"idr.vergent_search_px", "P: the vergent stage resolves +-P px (IDR termination)",
-       &f.idr.vergent_search_px, 0.5, 64},
-      {"idr.max_stages", "baseline stage budget", &f.idr.max_stages, 1, 20},
-      {"idr.patch_size_px", "IDR patch size, pixels", &f.idr.patch_size_px, 4, 128},
-      {"foveal.baseline_m", "vergent baseline, metres", &f.fixation.baseline_m, 0.001, 0.6},
-      {"foveal.choose_placement",
-       "beyond the paper: place the carriages per fixation (symmetric, right or left carriage "
-       "innermost) so that no mapped surface hides the point from either camera (false: symmetric "
-       "about the rail centre)",
-       &f.fixation.choose_placement},
-      {"foveal.left_pair",
-       "beyond the paper, with foveal.choose_placement: where the map hides a point from every "
-       "right camera, pair the left camera with itself at two carriage positions (the home pose's "
-       "and foveal.baseline_m to its left; motion stereo, the scene must hold still)",
-       &f.fixation.left_pair},
-      {"foveal.horizontal_disparity_limit_px",
-       "the fovea's horizontal disparity limit (sets Z_T), pixels",
-       &f.fixation.foveal.tessellation.horizontal_disparity_limit_px, 2, 256},
-      {"foveal.max_levels", "resolution levels of the tessellation",
-       &f.fixation.foveal.tessellation.max_levels, 1, 6},
-      {"foveal.fovea_patch_px", "patch size at full resolution, pixels",
-       &f.fixation.foveal.fovea_patch_px, 4, 64},
-      {"foveal.periphery_patch_px",
-       "patch size at coarser levels, full-resolution pixels (at least 4 pixels of the level)",
-       &f.fixation.foveal.periphery_patch_px, 4, 64},
-      {"foveal.silent_check",
-       "beyond the paper: where the map is silent, also search every depth from idr.z_min_m to "
-       "infinity and drop the Z_T matches it confidently contradicts (false: the paper's rule, Z_T "
-       "only)",
-       &f.silent_check},
-      {"foveal.servo_tolerance_px", "servoing stops below this centre disparity, pixels",
-       &f.fixation.servo.tolerance_px, 0.01, 10},
-      {"foveal.servo_search_px", "servoing's first search on a mapped point: +- this many pixels",
-       &f.fixation.servo.search_px, 1, 300},
-      {"foveal.servo_unique_ratio",
-       "servoing on a hole searches every depth and keeps its best match only if its cost is below "
-       "this share of the best elsewhere (1 = any)",
-       &f.fixation.servo.unique_ratio, 0.01, 1},
-      {"foveal.servo_mutual_px",
-       "beyond the paper: a converged servo's match must be mutual (the right centre window, "
-       "searched back along the left image's row, lands within this many pixels of the left "
-       "centre), else the point is refused (0 = no check)",
-       &f.fixation.servo.mutual_tolerance_px, 0, 100},
-      {"foveal.silent_confidence",
-       "see foveal.silent_check: the wider search's match confidence needed to drop a band match",
-       &f.fixation.foveal.silent_confidence, 0, 1},
-      {"foveal.servo_max_steps", "servoing step budget", &f.fixation.servo.max_steps, 0, 50},
-      {"selection.deterministic", "always fixate the composite's maximum instead of drawing",
-       &f.selection.deterministic},
-      {"selection.draw_scale", "scale s of the exponential draw", &f.selection.draw_scale, 0.001,
-       100},
-      {"selection.histogram_bins", "bins of the composite's histogram", &f.selection.histogram_bins,
-       2, 4096},
-      {"selection.border_px", "fixation candidates keep this far from the image edge, pixels",
-       &f.selection.border_px, 0, 200},
-      {"selection.refused_radius_m",
-       "candidates this close to a point that could not be fixated are left out, metres",
-       &f.selection.refused_radius_m, 0, 1},
-      {"criteria.gradient", "use gradient attraction", &f.criteria.gradient},
-      {"criteria.suppression", "use local suppression", &f.criteria.suppression},
-      {"criteria.proximity_2d", "use 2D proximity", &f.criteria.proximity_2d},
-      {"criteria.proximity_3d", "use 3D proximity", &f.criteria.proximity_3d},
-      {"criteria.gradient_blur_px", "gradient attraction's smoothing scale, pixels",
-       &f.criteria.gradient_blur_px, 0.1, 50},
-      {"criteria.suppressed_weight",
-       "local suppression's weight where the map is foveal (1 elsewhere)",
-       &f.criteria.suppressed_weight, 0, 1},
-      {"criteria.suppression_radius_m",
-       "local suppression also covers this distance around earlier fixation points, metres",
-       &f.criteria.suppression_radius_m, 0, 1},
-      {"criteria.peripheral_weight",
-       "local suppression's weight where the map is peripheral (1 = the paper's rule: foveal data "
-       "only)",
-       &f.criteria.peripheral_weight, 0, 1},
-      {"criteria.revisit_radius_m",
-       "local suppression's weight is 0 this close to an earlier fixation point (or a hole's point "
-       "aimed at), metres",
-       &f.criteria.revisit_radius_m, 0, 1},
-      {"criteria.proximity_2d_scale_px", "2D proximity's scale s in exp(-r / s), pixels",
-       &f.criteria.proximity_2d_scale_px, 1, kBig},
-      {"criteria.proximity_3d_low", "3D proximity's weight outside the Z_T band (1 inside)",
-       &f.criteria.proximity_3d_low, 0, 1},
-      {"static.baseline_m",
-       "static_sgbm's baseline, metres (0 = the widest at which a point at idr.z_min_m keeps "
-       "within half the image width)",
-       &c->static_baseline_m, 0, 4},
-      {"integration.overlap_share",
-       "overlap share at which new patches replace old ones (and finer data blocks new ones)",
-       &f.integration.overlap_share, 0.01, 1},
-  };
+  params->insert(params->end(), {
+                                    {&fp::kLoopFixations, &f.fixations},
+                                    {&fp::kLoopStayInIdrView, &f.stay_in_idr_view},
+                                    {&fp::kLoopFixateHoles, &f.fixate_holes},
+                                    {&fp::kLoopStallFixations, &f.stall_fixations},
+                                    {&fp::kLoopStallGrowth, &f.stall_growth},
+                                    {&fp::kLoopAttemptsPerFixation, &f.attempts_per_fixation},
+                                });
+}
+
+// Initial depth recovery.
+void AddIdrParams(RunConfig* c, std::vector<ConfigParam>* params) {
+  namespace fp = fovea::params;
+  fovea::FoveaOptions& f = c->fovea;
+  params->insert(params->end(),
+                 {
+                     {&fp::kIdrLogSigmaPx, &f.idr.zero_crossings.sigma_px},
+                     {&fp::kIdrLogMinSlope, &f.idr.zero_crossings.min_slope},
+                     {&fp::kIdrOrientationToleranceRad, &f.idr.matching.orientation_tolerance_rad},
+                     {&fp::kIdrTakeNearest, &f.idr.matching.take_nearest_when_ambiguous},
+                     {&fp::kIdrUniqueShare, &f.idr.unique_share},
+                     {&fp::kIdrZMinM, &f.idr.z_min_m},
+                     {&fp::kIdrMaxSlantDeg, &f.idr.max_slant_deg},
+                     {&fp::kIdrMaxExpansion, &f.idr.max_expansion},
+                     {&fp::kIdrMinExpansion, &f.idr.min_expansion},
+                     {&fp::kIdrVergentSearchPx, &f.idr.vergent_search_px},
+                     {&fp::kIdrVergentBaselineM, &f.idr.vergent_baseline_m},
+                     {&fp::kIdrMaxStages, &f.idr.max_stages},
+                     {&fp::kIdrPatchSizePx, &f.idr.patch_size_px},
+                     {&fp::kIdrDiscontinuityJumpPx, &f.idr.discontinuity_jump_px},
+                     {&fp::kIdrInitialBaselineM, &f.idr.fixed_initial_baseline_m},
+                     {&fp::kIdrFitMinSupport, &f.idr.plane_fit.min_support},
+                     {&fp::kIdrFitTolerancePx, &f.idr.plane_fit.fit_tolerance_px},
+                     {&fp::kIdrFitMinInlierShare, &f.idr.plane_fit.min_inlier_share},
+                     {&fp::kIdrFitRequireQuadrants, &f.idr.plane_fit.require_quadrants},
+                 });
+}
+
+// Vergence, servo, tessellation and foveal stereo.
+void AddFovealParams(RunConfig* c, std::vector<ConfigParam>* params) {
+  namespace fp = fovea::params;
+  fovea::FoveaOptions& f = c->fovea;
+  fovea::FixationOptions& x = c->fovea.fixation;
+  params->insert(params->end(),
+                 {
+                     {&fp::kFovealBaselineM, &x.baseline_m},
+                     {&fp::kFovealChoosePlacement, &x.choose_placement},
+                     {&fp::kFovealLeftPair, &x.left_pair},
+                     {&fp::kFovealVergenceMaxIterations, &x.vergence.max_iterations},
+                     {&fp::kFovealVergenceTolerancePx, &x.vergence.tolerance_px},
+                     {&fp::kFovealVergenceMinDistanceM, &x.vergence.min_distance_m},
+                     {&fp::kFovealHorizontalDisparityLimitPx,
+                      &x.foveal.tessellation.horizontal_disparity_limit_px},
+                     {&fp::kFovealMaxLevels, &x.foveal.tessellation.max_levels},
+                     {&fp::kFovealFoveaPatchPx, &x.foveal.fovea_patch_px},
+                     {&fp::kFovealPeripheryPatchPx, &x.foveal.periphery_patch_px},
+                     {&fp::kFovealMapMarginPx, &x.foveal.map_margin_px},
+                     {&fp::kFovealCoarseMarginPx, &x.foveal.coarse_margin_px},
+                     {&fp::kFovealFitMinSupport, &x.foveal.plane_fit.min_support},
+                     {&fp::kFovealFitTolerancePx, &x.foveal.plane_fit.fit_tolerance_px},
+                     {&fp::kFovealFitMinInlierShare, &x.foveal.plane_fit.min_inlier_share},
+                     {&fp::kFovealFitRequireQuadrants, &x.foveal.plane_fit.require_quadrants},
+                     {&fp::kFovealSilentCheck, &f.silent_check},
+                     {&fp::kFovealServoWindowHalfPx, &x.servo.window_half_px},
+                     {&fp::kFovealServoTolerancePx, &x.servo.tolerance_px},
+                     {&fp::kFovealServoSearchPx, &x.servo.search_px},
+                     {&fp::kFovealServoRefinePx, &x.servo.refine_px},
+                     {&fp::kFovealServoUniqueRatio, &x.servo.unique_ratio},
+                     {&fp::kFovealServoMutualPx, &x.servo.mutual_tolerance_px},
+                     {&fp::kFovealSilentConfidence, &x.foveal.silent_confidence},
+                     {&fp::kFovealServoMaxSteps, &x.servo.max_steps},
+                 });
+}
+
+// The matchers, selection, criteria, the static baseline, integration.
+void AddDdrParams(RunConfig* c, std::vector<ConfigParam>* params) {
+  namespace fp = fovea::params;
+  namespace ep = params;
+  fovea::FoveaOptions& f = c->fovea;
+  params->insert(params->end(),
+                 {
+                     {&fp::kNl1WindowHalfPx, &f.nl1.window_half_px},
+                     {&fp::kNl1MinTextureDn, &f.nl1.min_texture_dn},
+                     {&fp::kNl1LrTolerancePx, &f.nl1.lr_tolerance_px},
+                     {&fp::kSgbmBlockSize, &f.sgbm.block_size},
+                     {&fp::kSgbmUniquenessRatio, &f.sgbm.uniqueness_ratio},
+                     {&fp::kSgbmSpeckleWindow, &f.sgbm.speckle_window},
+                     {&fp::kSgbmSpeckleRange, &f.sgbm.speckle_range},
+                     {&fp::kSelectionDeterministic, &f.selection.deterministic},
+                     {&fp::kSelectionDrawScale, &f.selection.draw_scale},
+                     {&fp::kSelectionHistogramBins, &f.selection.histogram_bins},
+                     {&fp::kSelectionBorderPx, &f.selection.border_px},
+                     {&fp::kSelectionRefusedRadiusM, &f.selection.refused_radius_m},
+                     {&fp::kCriteriaGradient, &f.criteria.gradient},
+                     {&fp::kCriteriaSuppression, &f.criteria.suppression},
+                     {&fp::kCriteriaProximity2d, &f.criteria.proximity_2d},
+                     {&fp::kCriteriaProximity3d, &f.criteria.proximity_3d},
+                     {&fp::kCriteriaGradientBlurPx, &f.criteria.gradient_blur_px},
+                     {&fp::kCriteriaSuppressedWeight, &f.criteria.suppressed_weight},
+                     {&fp::kCriteriaSuppressionRadiusM, &f.criteria.suppression_radius_m},
+                     {&fp::kCriteriaPeripheralWeight, &f.criteria.peripheral_weight},
+                     {&fp::kCriteriaRevisitRadiusM, &f.criteria.revisit_radius_m},
+                     {&fp::kCriteriaProximity2dScalePx, &f.criteria.proximity_2d_scale_px},
+                     {&fp::kCriteriaProximity3dLow, &f.criteria.proximity_3d_low},
+                     {&ep::kStaticBaselineM, &c->static_baseline_m},
+                     {&fp::kIntegrationOverlapShare, &f.integration.overlap_share},
+                 });
+}
+
+}  // namespace
+
+std::vector<ConfigParam> ConfigParams(RunConfig* c) {
+  std::vector<ConfigParam> params;
+  params.reserve(128);
+  for (auto add :
+       {AddTopParams, AddRigParams, AddLoopParams, AddIdrParams, AddFovealParams, AddDdrParams})
+    add(c, &params);
+  return params;
 }
 
 void SetParam(RunConfig* config, const std::string& path, const std::string& value) {
   for (const ConfigParam& p : ConfigParams(config))
-    if (p.path == path) return Assign(p, value, "key '" + path + "'");
+    if (p.path() == path) return Assign(p, value, "key '" + path + "'");
   throw UsageError("unknown key '" + rig::ClipForMessage(path) + "'");
 }
 
 void SetParamFromFlag(RunConfig* config, const std::string& flag, const std::string& path,
                       const std::string& value) {
   for (const ConfigParam& p : ConfigParams(config))
-    if (p.path == path) return Assign(p, value, flag + " (" + path + ")");
+    if (p.path() == path) return Assign(p, value, flag + " (" + path + ")");
   throw std::logic_error("flag " + flag + " names no parameter '" + path + "'");
 }
 
@@ -457,7 +439,7 @@ RunConfig LoadConfig(const std::string& path) {
   ApplyYaml(root, &config, where);
   try {
     config.Check();
-  } catch (const UsageError& e) {
+  } catch (const rig::InputError& e) {
     throw UsageError(where + e.what());
   }
   return config;
@@ -468,21 +450,27 @@ void ApplyYaml(const YAML::Node& root, RunConfig* config, const std::string& whe
   if (!root.IsMap()) throw UsageError(where + "expected a mapping of keys at the top level");
   const std::vector<ConfigParam> params = ConfigParams(config);
   std::map<std::string, const ConfigParam*> by_path;
-  for (const ConfigParam& p : params) by_path[p.path] = &p;
+  for (const ConfigParam& p : params) by_path[p.path()] = &p;
   Walk(root, "", by_path, where);
 }
 
 void RunConfig::Check() const {
+  // Each parameter against its spec (the libraries' Check() use the same
+  // specs for their own options), then the parts against each other.
   try {
     fovea.Check();
-  } catch (const std::invalid_argument& e) {
-    throw UsageError(e.what());
-  }
-  sim::SimRigConfig r = rig;
-  r.seed = seed;
-  try {
-    r.Check();
-  } catch (const sim::SceneError& e) {
+    rig.Check();
+    RunConfig copy = *this;
+    for (const ConfigParam& p : ConfigParams(&copy)) {
+      if (const auto* d = std::get_if<double*>(&p.target)) rig::CheckParam(*p.spec, **d);
+      if (const auto* i = std::get_if<int*>(&p.target)) rig::CheckParam(*p.spec, **i);
+      if (const auto* u = std::get_if<uint64_t*>(&p.target))
+        rig::CheckParam(*p.spec, static_cast<double>(**u));
+      if (const auto* t = std::get_if<std::string*>(&p.target)) rig::CheckParam(*p.spec, **t);
+    }
+  } catch (const UsageError&) {
+    throw;
+  } catch (const rig::InputError& e) {
     throw UsageError(e.what());
   }
   const auto units = SixInts(hardware.units, "rig.units");
@@ -508,14 +496,13 @@ void RunConfig::Check() const {
       throw UsageError("key 'rig.calibration': a hardware rig needs a calibration file");
   }
   const double widest = 2 * rig.carriage_max_m;
-  if (rig.home_baseline_m > widest)
-    throw UsageError("key 'rig.home_baseline_m': " + FormatNumber(rig.home_baseline_m) +
-                     " is wider than the carriages allow (2 x rig.carriage_max_m = " +
-                     FormatNumber(widest) + ")");
-  if (fovea.fixation.baseline_m > widest)
-    throw UsageError("key 'foveal.baseline_m': " + FormatNumber(fovea.fixation.baseline_m) +
-                     " is wider than the carriages allow (2 x rig.carriage_max_m = " +
-                     FormatNumber(widest) + ")");
+  for (const auto& [key, baseline] :
+       {std::pair<const char*, double>{"foveal.baseline_m", fovea.fixation.baseline_m},
+        {"static.baseline_m", static_baseline_m}})
+    if (baseline > widest)
+      throw UsageError(std::string("key '") + key + "': " + FormatNumber(baseline) +
+                       " is wider than the carriages allow (2 x rig.carriage_max_m = " +
+                       FormatNumber(widest) + ")");
 }
 
 std::vector<std::string> SplitFields(const std::string& text) {
@@ -545,7 +532,7 @@ std::array<int, 6> SixInts(const std::string& text, const std::string& key) {
 std::vector<std::pair<std::string, std::string>> ParamValues(const RunConfig& const_config) {
   RunConfig config = const_config;
   std::vector<std::pair<std::string, std::string>> values;
-  for (const ConfigParam& p : ConfigParams(&config)) values.emplace_back(p.path, ValueText(p));
+  for (const ConfigParam& p : ConfigParams(&config)) values.emplace_back(p.path(), ValueText(p));
   return values;
 }
 
@@ -568,7 +555,7 @@ std::string ConfigHash(const RunConfig& config) {
 
 std::string ParamText(RunConfig* config, const std::string& path) {
   for (const ConfigParam& p : ConfigParams(config))
-    if (p.path == path) return ValueText(p);
+    if (p.path() == path) return ValueText(p);
   throw UsageError("unknown key '" + path + "'");
 }
 
@@ -578,15 +565,17 @@ std::string DumpConfig(const RunConfig& const_config) {
   out << "# FOVEA run configuration: every parameter, with its meaning and range.\n";
   std::string section;
   for (const ConfigParam& p : ConfigParams(&config)) {
-    const size_t dot = p.path.find('.');
-    const std::string sec = dot == std::string::npos ? "" : p.path.substr(0, dot);
-    const std::string key = dot == std::string::npos ? p.path : p.path.substr(dot + 1);
+    const std::string path = p.path();
+    const size_t dot = path.find('.');
+    const std::string sec = dot == std::string::npos ? "" : path.substr(0, dot);
+    const std::string key = dot == std::string::npos ? path : path.substr(dot + 1);
     if (sec != section) {
       out << sec << ":\n";
       section = sec;
     }
     const std::string indent = sec.empty() ? "" : "  ";
-    out << indent << key << ": " << YamlValueText(p) << "  # " << p.doc << "; " << Range(p) << "\n";
+    out << indent << key << ": " << YamlValueText(p) << "  # " << p.spec->doc << "; " << Range(p)
+        << "\n";
   }
   return out.str();
 }

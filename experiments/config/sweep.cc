@@ -79,9 +79,7 @@ std::vector<std::string> AxisValues(const YAML::Node& node, const std::string& w
 void CheckScene(const std::string& scene, const std::string& where) {
   if (scene.empty()) return;
   try {
-    const std::string path = scenes::ResolveScene(scene);
-    if (path.rfind("random:", 0) != 0 && !fs::is_regular_file(path))
-      throw UsageError(where + "scene '" + scene + "': no such file");
+    scenes::SceneSource::Parse(scene).CheckReadable();
   } catch (const sim::SceneError& e) {
     throw UsageError(where + e.what());
   }
@@ -110,20 +108,14 @@ Sweep LoadSweep(const std::string& path) {
   return ParseSweep(text, path);
 }
 
-Sweep ParseSweep(const std::string& text, const std::string& path) {
-  const std::string where = "sweep " + rig::ClipForMessage(path) + ": ";
-  const YAML::Node root = ParseYaml(text, where);
-  if (!root.IsMap())
-    throw UsageError(where + "expected a mapping with base, config, axes, baselines, jobs");
-  Sweep sweep;
-  sweep.file = path;
+namespace {
+
+using Point = std::vector<std::pair<std::string, std::string>>;  ///< axis path -> value
+
+// The base configuration: the defaults, a `base:` config file (relative to
+// the sweep file) and the `config:` mapping over it.
+RunConfig ParseBase(const YAML::Node& root, const std::string& path, const std::string& where) {
   RunConfig base;
-  for (const auto& kv : root) {
-    const std::string key = kv.first.as<std::string>();
-    if (key != "base" && key != "config" && key != "axes" && key != "baselines" && key != "jobs")
-      throw UsageError(where + "unknown key '" + rig::ClipForMessage(key) +
-                       "' (expected base, config, axes, baselines, jobs)");
-  }
   if (root["base"]) {
     if (!root["base"].IsScalar()) throw UsageError(where + "key 'base': expected a file name");
     fs::path b = root["base"].Scalar();
@@ -135,30 +127,36 @@ Sweep ParseSweep(const std::string& text, const std::string& path) {
       throw UsageError(where + "key 'config': expected a mapping of parameters");
     ApplyYaml(root["config"], &base, where + "config: ");
   }
-  if (root["jobs"]) {
-    const std::optional<double> jobs =
-        root["jobs"].IsScalar() ? ParseNumber(root["jobs"].Scalar()) : std::nullopt;
-    if (!jobs || *jobs != std::floor(*jobs) || *jobs < 0 || *jobs > 1024)
-      throw UsageError(where + "key 'jobs': expected a whole number in [0, 1024] (0 = every core)");
-    sweep.jobs = static_cast<int>(*jobs);
-  }
+  CheckScene(base.scene, where + "key 'scene': ");
+  return base;
+}
+
+int ParseJobs(const YAML::Node& root, const std::string& where) {
+  if (!root["jobs"]) return 0;
+  const std::optional<double> jobs =
+      root["jobs"].IsScalar() ? ParseNumber(root["jobs"].Scalar()) : std::nullopt;
+  if (!jobs || *jobs != std::floor(*jobs) || *jobs < 0 || *jobs > 1024)
+    throw UsageError(where + "key 'jobs': expected a whole number in [0, 1024] (0 = every core)");
+  return static_cast<int>(*jobs);
+}
+
+// The axes, each value checked over the base configuration.
+std::vector<SweepAxis> ParseAxes(const YAML::Node& root, const RunConfig& base,
+                                 const std::string& where) {
   if (!root["axes"] || !root["axes"].IsMap() || root["axes"].size() == 0)
     throw UsageError(where + "key 'axes': expected a mapping of parameter paths to values");
+  std::vector<SweepAxis> axes;
   for (const auto& kv : root["axes"]) {
     SweepAxis axis;
     axis.path = kv.first.as<std::string>();
-    const std::string at = where + "axes: key '" + axis.path + "': ";
-    {
-      RunConfig probe;
-      try {
-        ParamText(&probe, axis.path);
-      } catch (const UsageError&) {
-        throw UsageError(where + "axes: unknown key '" + rig::ClipForMessage(axis.path) + "'");
-      }
+    RunConfig probe = base;
+    try {
+      ParamText(&probe, axis.path);
+    } catch (const UsageError&) {
+      throw UsageError(where + "axes: unknown key '" + rig::ClipForMessage(axis.path) + "'");
     }
-    axis.values = AxisValues(kv.second, at);
+    axis.values = AxisValues(kv.second, where + "axes: key '" + axis.path + "': ");
     for (const std::string& v : axis.values) {
-      RunConfig probe = base;
       try {
         SetParam(&probe, axis.path, v);
       } catch (const UsageError& e) {
@@ -166,68 +164,96 @@ Sweep ParseSweep(const std::string& text, const std::string& path) {
       }
       if (axis.path == "scene") CheckScene(v, where + "axes: key 'scene': ");
     }
-    for (const SweepAxis& a : sweep.axes)
-      if (a.path == axis.path)
-        throw UsageError(where + "axes: key '" + axis.path + "' appears twice");
-    sweep.axes.push_back(axis);
+    axes.push_back(axis);
   }
-  if (root["baselines"]) {
-    if (!root["baselines"].IsSequence())
-      throw UsageError(where + "key 'baselines': expected a list");
-    for (const auto& b : root["baselines"]) {
-      const std::string name = b.IsScalar() ? b.Scalar() : "";
-      if (name != "deterministic" && name != "static_sgbm")
-        throw UsageError(where + "key 'baselines': '" + rig::ClipForMessage(name) +
-                         "' is not one of deterministic, static_sgbm");
-      sweep.baselines.push_back(name);
-    }
-  }
+  return axes;
+}
 
-  // The grid, last axis fastest.
+std::vector<std::string> ParseBaselines(const YAML::Node& root, const std::string& where) {
+  std::vector<std::string> baselines;
+  if (!root["baselines"]) return baselines;
+  if (!root["baselines"].IsSequence()) throw UsageError(where + "key 'baselines': expected a list");
+  for (const auto& b : root["baselines"]) {
+    const std::string name = b.IsScalar() ? b.Scalar() : "";
+    if (name != "deterministic" && name != "static_sgbm")
+      throw UsageError(where + "key 'baselines': '" + rig::ClipForMessage(name) +
+                       "' is not one of deterministic, static_sgbm");
+    baselines.push_back(name);
+  }
+  return baselines;
+}
+
+// Every point of the grid, last axis fastest; refuses a grid past the limit.
+std::vector<Point> GridPoints(const std::vector<SweepAxis>& axes, size_t baselines,
+                              const std::string& where) {
   long total = 1;
-  for (const SweepAxis& a : sweep.axes) {
+  for (const SweepAxis& a : axes) {
     total *= static_cast<long>(a.values.size());
-    if (total * static_cast<long>(1 + sweep.baselines.size()) > kMaxSweepRuns)
+    if (total * static_cast<long>(1 + baselines) > kMaxSweepRuns)
       throw UsageError(where + "the grid has more than " + std::to_string(kMaxSweepRuns) +
                        " runs (the limit of one sweep; split it into several)");
   }
-  std::set<std::string> seen;
-  auto add = [&](const RunConfig& c,
-                 const std::vector<std::pair<std::string, std::string>>& point) {
-    RunConfig config = c;
-    if (config.scene.empty()) config.scene = scenes::kDefaultScene;
-    try {
-      config.Check();
-    } catch (const UsageError& e) {
-      std::string at;
-      for (const auto& [p, v] : point) at += (at.empty() ? "" : ", ") + p + "=" + v;
-      throw UsageError(where + "run " + at + ": " + e.what());
-    }
-    SweepRun run{ConfigHash(config), Variant(config), config, point};
-    if (seen.insert(run.id).second) sweep.runs.push_back(std::move(run));
-  };
-  CheckScene(base.scene, where + "key 'scene': ");
-  std::vector<std::vector<std::pair<std::string, std::string>>> points;
-  std::vector<size_t> index(sweep.axes.size(), 0);
+  std::vector<Point> points;
+  std::vector<size_t> index(axes.size(), 0);
   for (long i = 0; i < total; ++i) {
-    std::vector<std::pair<std::string, std::string>> point;
-    for (size_t a = 0; a < sweep.axes.size(); ++a)
-      point.emplace_back(sweep.axes[a].path, sweep.axes[a].values[index[a]]);
+    Point point;
+    for (size_t a = 0; a < axes.size(); ++a)
+      point.emplace_back(axes[a].path, axes[a].values[index[a]]);
     points.push_back(point);
-    for (size_t a = sweep.axes.size(); a-- > 0;) {
-      if (++index[a] < sweep.axes[a].values.size()) break;
+    for (size_t a = axes.size(); a-- > 0;) {
+      if (++index[a] < axes[a].values.size()) break;
       index[a] = 0;
     }
   }
-  for (const auto& point : points) {
+  return points;
+}
+
+// Adds the run of one grid point (or one baseline's), checked, unless an
+// identical configuration is there already.
+void AddRun(RunConfig config, const Point& point, const std::string& where,
+            std::set<std::string>* seen, Sweep* sweep) {
+  if (config.scene.empty()) config.scene = scenes::kDefaultScene;
+  try {
+    config.Check();
+  } catch (const rig::InputError& e) {
+    std::string at;
+    for (const auto& [p, v] : point) at += (at.empty() ? "" : ", ") + p + "=" + v;
+    throw UsageError(where + "run " + at + ": " + e.what());
+  }
+  SweepRun run{ConfigHash(config), Variant(config), config, point};
+  if (seen->insert(run.id).second) sweep->runs.push_back(std::move(run));
+}
+
+}  // namespace
+
+Sweep ParseSweep(const std::string& text, const std::string& path) {
+  const std::string where = "sweep " + rig::ClipForMessage(path) + ": ";
+  const YAML::Node root = ParseYaml(text, where);
+  if (!root.IsMap())
+    throw UsageError(where + "expected a mapping with base, config, axes, baselines, jobs");
+  for (const auto& kv : root) {
+    const std::string key = kv.first.as<std::string>();
+    if (key != "base" && key != "config" && key != "axes" && key != "baselines" && key != "jobs")
+      throw UsageError(where + "unknown key '" + rig::ClipForMessage(key) +
+                       "' (expected base, config, axes, baselines, jobs)");
+  }
+  Sweep sweep;
+  sweep.file = path;
+  const RunConfig base = ParseBase(root, path, where);
+  sweep.jobs = ParseJobs(root, where);
+  sweep.axes = ParseAxes(root, base, where);
+  sweep.baselines = ParseBaselines(root, where);
+  const std::vector<Point> points = GridPoints(sweep.axes, sweep.baselines.size(), where);
+  std::set<std::string> seen;
+  for (const Point& point : points) {
     RunConfig c = base;
     for (const auto& [p, v] : point) SetParam(&c, p, v);
-    add(c, point);
+    AddRun(c, point, where, &seen, &sweep);
   }
   for (const std::string& b : sweep.baselines)
-    for (const auto& point : points) {
+    for (const Point& point : points) {
       RunConfig c = base;
-      std::vector<std::pair<std::string, std::string>> kept;
+      Point kept;
       for (const auto& [p, v] : point)
         if (b == "deterministic" || ConcernsStatic(p)) {
           SetParam(&c, p, v);
@@ -237,7 +263,7 @@ Sweep ParseSweep(const std::string& text, const std::string& path) {
         c.fovea.selection.deterministic = true;
       else
         c.method = "static_sgbm";
-      add(c, kept);
+      AddRun(c, kept, where, &seen, &sweep);
     }
   return sweep;
 }

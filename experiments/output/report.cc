@@ -12,8 +12,10 @@
 #include <set>
 #include <sstream>
 
+#include "experiments/config/config.h"
 #include "experiments/config/sweep.h"
 #include "experiments/output/output.h"
+#include "experiments/output/run_folder.h"
 
 namespace experiments {
 namespace fs = std::filesystem;
@@ -90,35 +92,21 @@ double Num(const nlohmann::json& j, const std::string& dotted) {
   return p->is_number() ? p->get<double>() : std::nan("");
 }
 
-std::string RunReport(const std::string& dir) {
-  const nlohmann::json s = ReadJson(dir + "/summary.json");
-  std::string h =
-      "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>FOVEA run: " + Html(dir) +
-      "</title>" + kStyle + "</head><body>\n";
-  h += "<h1>FOVEA run</h1><p>Folder <code>" + Html(dir) + "</code>, scene <code>" +
-       Html(s.value("scene", std::string())) + "</code>, seed " +
-       s.value("seed", nlohmann::json(0)).dump() + ", method " +
-       Html(s.value("method", std::string("fovea"))) + ".</p>\n";
-  h += "<h2>Figures</h2><table>";
-  const std::vector<std::pair<std::string, std::string>> rows = {
-      {"fixations", "fixations done"},
-      {"coverage", "coverage of visible textured pixels"},
-      {"foveal_coverage", "share mapped at foveal resolution"},
-      {"median_abs_error_m", "median |depth error|, m"},
-      {"median_rel_error", "median relative error"},
-      {"median_error_steps", "median error, disparity steps"},
-      {"rmse_m", "RMSE, m"},
-      {"within_1pct", "share within 1% of depth"},
-      {"patch_3d_error.median_m", "median per-patch 3D error, m"},
-      {"motion_time_s", "simulated motion time, s"},
-      {"compute_time_s", "compute time, s"},
-      {"wall_time_s", "wall time, s"}};
+// A figure per row of `rows` (summary key, label) that the summary holds.
+std::string FigureTable(const nlohmann::json& s,
+                        const std::vector<std::pair<std::string, std::string>>& rows) {
+  std::string h = "<table>";
   for (const auto& [key, label] : rows) {
     const double v = Num(s, key);
     if (std::isfinite(v))
       h += "<tr><th class=l>" + Html(label) + "</th><td>" + Fmt(v) + "</td></tr>";
   }
-  h += "</table>\n";
+  return h + "</table>\n";
+}
+
+// The run's figures by resolution level and by surface.
+std::string LevelAndSurfaceTables(const nlohmann::json& s) {
+  std::string h;
   if (s.contains("by_level")) {
     h += "<h3>By level</h3><table><tr><th class=l>level</th><th>share</th><th>median error, "
          "m</th><th>median "
@@ -141,10 +129,13 @@ std::string RunReport(const std::string& dir) {
            Fmt(Num(it.value(), "median_abs_error_m")) + "</td></tr>";
     h += "</table>\n";
   }
+  return h;
+}
 
-  // Curves against fixation count, from the per-fixation records.
+// Curves against fixation count, from the per-fixation records.
+std::string FixationCurves(const std::string& dir) {
   Series cov{"coverage"}, fov{"foveal coverage"}, med{"median |error|"}, rmse{"RMSE"};
-  std::ifstream in(dir + "/fixations.jsonl");
+  std::ifstream in(dir + "/" + run_folder::kRecords);
   for (std::string line; std::getline(in, line);) {
     if (line.empty()) continue;
     const nlohmann::json r = nlohmann::json::parse(line);
@@ -156,52 +147,188 @@ std::string RunReport(const std::string& dir) {
     med.x.push_back(f), med.y.push_back(1e3 * Num(sc, "median_abs_error_m"));
     rmse.x.push_back(f), rmse.y.push_back(1e3 * Num(sc, "rmse_m"));
   }
-  if (!cov.x.empty()) {
-    h += "<h2>Against fixation count</h2><div class=plots>";
-    h += GnuplotSvg("Coverage of the reference view", "fixation",
-                    "share of visible textured pixels", {cov, fov});
-    h += GnuplotSvg("Depth error", "fixation", "mm", {med, rmse}, true);
-    h += "</div>\n";
+  if (cov.x.empty()) return "";
+  return "<h2>Against fixation count</h2><div class=plots>" +
+         GnuplotSvg("Coverage of the reference view", "fixation",
+                    "share of visible textured pixels", {cov, fov}) +
+         GnuplotSvg("Depth error", "fixation", "mm", {med, rmse}, true) + "</div>\n";
+}
+
+std::string RunPictures(const std::string& dir) {
+  std::string h = "<h2>Pictures</h2>\n";
+  for (const int k : run_folder::kSnapshotFixations) {
+    const std::string name = dir + "/" + run_folder::SnapshotName(k);
+    if (fs::exists(name)) h += Img(name, "the map after fixation " + std::to_string(k));
   }
-  h += "<h2>Pictures</h2>\n";
-  for (const int k : {1, 5, 15, 25}) {
-    char name[32];
-    std::snprintf(name, sizeof name, "/map_after_%02d.png", k);
-    if (fs::exists(dir + name)) h += Img(dir + name, "the map after fixation " + std::to_string(k));
-  }
-  if (fs::exists(dir + "/map.png")) h += Img(dir + "/map.png", "the map");
-  if (fs::exists(dir + "/fixation_path.png"))
-    h += Img(dir + "/fixation_path.png", "the fixation path");
-  h += "</body></html>\n";
+  const std::pair<const char*, const char*> more[] = {
+      {run_folder::kMapPicture, "the map"}, {run_folder::kFixationPath, "the fixation path"}};
+  for (const auto& [file, alt] : more)
+    if (fs::exists(dir + "/" + file)) h += Img(dir + "/" + file, alt);
   return h;
 }
 
-std::string SweepReport(const std::string& dir) {
-  const nlohmann::json grid = ReadJson(dir + "/grid.json");
-  struct Row {
-    std::string id, variant, scene;
-    std::map<std::string, std::string> point;
-    nlohmann::json summary;
-  };
-  std::vector<Row> rows;
-  int missing = 0;
+std::string RunReport(const std::string& dir) {
+  const nlohmann::json s = ReadJson(dir + "/" + run_folder::kSummary);
+  std::string h =
+      "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>FOVEA run: " + Html(dir) +
+      "</title>" + kStyle + "</head><body>\n";
+  h += "<h1>FOVEA run</h1><p>Folder <code>" + Html(dir) + "</code>, scene <code>" +
+       Html(s.value("scene", std::string())) + "</code>, seed " +
+       s.value("seed", nlohmann::json(0)).dump() + ", method " +
+       Html(s.value("method", std::string("fovea"))) + ".</p>\n";
+  h += "<h2>Figures</h2>" +
+       FigureTable(s, {{"fixations", "fixations done"},
+                       {"coverage", "coverage of visible textured pixels"},
+                       {"foveal_coverage", "share mapped at foveal resolution"},
+                       {"median_abs_error_m", "median |depth error|, m"},
+                       {"median_rel_error", "median relative error"},
+                       {"median_error_steps", "median error, disparity steps"},
+                       {"rmse_m", "RMSE, m"},
+                       {"within_1pct", "share within 1% of depth"},
+                       {"patch_3d_error.median_m", "median per-patch 3D error, m"},
+                       {"motion_time_s", "simulated motion time, s"},
+                       {"compute_time_s", "compute time, s"},
+                       {"wall_time_s", "wall time, s"}});
+  h += LevelAndSurfaceTables(s) + FixationCurves(dir) + RunPictures(dir);
+  return h + "</body></html>\n";
+}
+
+// One finished run of a sweep, for the report.
+struct SweepRow {
+  std::string id, variant, scene;
+  std::map<std::string, std::string> point;
+  nlohmann::json summary;
+};
+
+std::vector<SweepRow> SweepRows(const std::string& dir, const nlohmann::json& grid, int* missing) {
+  std::vector<SweepRow> rows;
   for (const auto& run : grid.at("runs")) {
     const std::string id = run.at("id").get<std::string>();
-    if (!fs::exists(dir + "/runs/" + id + "/summary.json")) {
-      ++missing;
+    const std::string summary = dir + "/runs/" + id + "/" + run_folder::kSummary;
+    if (!fs::exists(summary)) {
+      ++*missing;
       continue;
     }
-    Row r{id,
-          run.at("variant").get<std::string>(),
-          "",
-          {},
-          ReadJson(dir + "/runs/" + id + "/summary.json")};
+    SweepRow r{id, run.at("variant").get<std::string>(), "", {}, ReadJson(summary)};
     for (auto it = run.at("point").begin(); it != run.at("point").end(); ++it)
       r.point[it.key()] = it.value();
     for (const auto& p : run.at("config"))
       if (p.at(0) == "scene") r.scene = p.at(1).get<std::string>();
     rows.push_back(r);
   }
+  return rows;
+}
+
+// The figures a sweep report plots and tabulates.
+const std::vector<std::pair<std::string, std::string>>& SweepFigures() {
+  static const std::vector<std::pair<std::string, std::string>> kFigures = {
+      {"coverage", "coverage"},
+      {"foveal_coverage", "foveal coverage"},
+      {"median_abs_error_m", "median |depth error|, m"},
+      {"median_rel_error", "median relative error"},
+      {"rmse_m", "RMSE, m"},
+      {"motion_time_s", "simulated motion time, s"},
+      {"wall_time_s", "wall time, s"}};
+  return kFigures;
+}
+
+// One figure against a numeric axis: a line per scene and variant (the mean
+// over the other axes, bars from smallest to largest), dashed lines for the
+// runs that do not depend on the axis.
+std::vector<Series> FigureSeries(const std::vector<SweepRow>& rows, const std::string& path,
+                                 const std::string& key, double x_min, double x_max) {
+  std::map<std::pair<std::string, std::string>, std::map<double, std::vector<double>>> groups;
+  std::map<std::pair<std::string, std::string>, std::vector<double>> flat;
+  for (const SweepRow& r : rows) {
+    const double v = Num(r.summary, key);
+    if (!std::isfinite(v)) continue;
+    const auto it = r.point.find(path);
+    if (it != r.point.end())
+      groups[{r.scene, r.variant}][std::strtod(it->second.c_str(), nullptr)].push_back(v);
+    else
+      flat[{r.scene, r.variant}].push_back(v);
+  }
+  auto mean = [](const std::vector<double>& vs) {
+    double sum = 0;
+    for (const double v : vs) sum += v;
+    return sum / vs.size();
+  };
+  std::vector<Series> series;
+  for (const auto& [g, by_x] : groups) {
+    Series s{g.first + ", " + g.second};
+    for (const auto& [x, vs] : by_x) {
+      s.x.push_back(x);
+      s.y.push_back(mean(vs));
+      s.y_lo.push_back(*std::min_element(vs.begin(), vs.end()));
+      s.y_hi.push_back(*std::max_element(vs.begin(), vs.end()));
+    }
+    series.push_back(s);
+  }
+  for (const auto& [g, vs] : flat) {
+    Series s{g.first + ", " + g.second};
+    s.x = {x_min, x_max};
+    s.y = {mean(vs), mean(vs)};
+    s.dashed = true;
+    series.push_back(s);
+  }
+  return series;
+}
+
+// Every figure against every numeric axis but scene and seed.
+std::string AxisPlots(const nlohmann::json& grid, const std::vector<SweepRow>& rows) {
+  std::string h;
+  for (const auto& a : grid.at("axes")) {
+    const std::string path = a.at("path").get<std::string>();
+    if (path == "scene" || path == "seed") continue;
+    std::vector<double> xs;
+    for (const auto& v : a.at("values")) {
+      const std::optional<double> x = ParseNumber(v.get<std::string>());
+      if (!x) break;
+      xs.push_back(*x);
+    }
+    if (xs.size() < 2 || xs.size() != a.at("values").size()) continue;
+    const double x_min = *std::min_element(xs.begin(), xs.end()),
+                 x_max = *std::max_element(xs.begin(), xs.end());
+    h += "<h2>Against <code>" + Html(path) +
+         "</code></h2><p>A line per scene and variant: the mean over the other axes (seeds, ...), "
+         "bars from the "
+         "smallest to the largest value. Baselines that do not depend on this parameter are dashed "
+         "horizontal "
+         "lines.</p><div class=plots>\n";
+    for (const auto& [key, label] : SweepFigures()) {
+      const std::vector<Series> series = FigureSeries(rows, path, key, x_min, x_max);
+      if (!series.empty()) h += GnuplotSvg(label, path, label, series);
+    }
+    h += "</div>\n";
+  }
+  return h;
+}
+
+std::string RunsTable(const nlohmann::json& grid, const std::vector<SweepRow>& rows) {
+  std::string h = "<h2>Runs</h2><table><tr><th class=l>run</th><th class=l>variant</th>";
+  for (const auto& a : grid.at("axes"))
+    h += "<th class=l>" + Html(a.at("path").get<std::string>()) + "</th>";
+  for (const auto& [key, label] : SweepFigures()) h += "<th>" + Html(label) + "</th>";
+  h += "</tr>\n";
+  for (const SweepRow& r : rows) {
+    h += "<tr><td class=l><a href=\"runs/" + r.id + "/\">" + r.id + "</a></td><td class=l>" +
+         r.variant + "</td>";
+    for (const auto& a : grid.at("axes")) {
+      const auto it = r.point.find(a.at("path").get<std::string>());
+      h += "<td class=l>" + (it == r.point.end() ? std::string("(base)") : Html(it->second)) +
+           "</td>";
+    }
+    for (const auto& [key, label] : SweepFigures())
+      h += "<td>" + Fmt(Num(r.summary, key)) + "</td>";
+    h += "</tr>\n";
+  }
+  return h + "</table>";
+}
+
+std::string SweepReport(const std::string& dir) {
+  const nlohmann::json grid = ReadJson(dir + "/grid.json");
+  int missing = 0;
+  const std::vector<SweepRow> rows = SweepRows(dir, grid, &missing);
   std::string h =
       "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>FOVEA sweep: " + Html(dir) +
       "</title>" + kStyle + "</head><body>\n<h1>FOVEA sweep</h1>\n";
@@ -221,95 +348,9 @@ std::string SweepReport(const std::string& dir) {
     baselines += (baselines.empty() ? "" : ", ") + b.get<std::string>();
   h += "</ul><p>Baselines: " + (baselines.empty() ? std::string("none") : Html(baselines)) +
        " (static_sgbm: StereoSGBM on the static parallel pair; deterministic: always the "
-       "composite's maximum).</p>\n";
-
-  const std::vector<std::pair<std::string, std::string>> figures = {
-      {"coverage", "coverage"},
-      {"foveal_coverage", "foveal coverage"},
-      {"median_abs_error_m", "median |depth error|, m"},
-      {"median_rel_error", "median relative error"},
-      {"rmse_m", "RMSE, m"},
-      {"motion_time_s", "simulated motion time, s"},
-      {"wall_time_s", "wall time, s"}};
-  for (const auto& a : grid.at("axes")) {
-    const std::string path = a.at("path").get<std::string>();
-    if (path == "scene" || path == "seed") continue;
-    std::vector<double> xs;
-    bool numeric = true;
-    for (const auto& v : a.at("values")) {
-      char* end = nullptr;
-      const std::string t = v.get<std::string>();
-      xs.push_back(std::strtod(t.c_str(), &end));
-      numeric &= end && *end == '\0' && !t.empty();
-    }
-    if (!numeric || xs.size() < 2) continue;
-    const double x_min = *std::min_element(xs.begin(), xs.end()),
-                 x_max = *std::max_element(xs.begin(), xs.end());
-    h += "<h2>Against <code>" + Html(path) +
-         "</code></h2><p>A line per scene and variant: the mean over the "
-         "other axes (seeds, ...), bars from the smallest to the largest value. Baselines that do "
-         "not depend "
-         "on this parameter are dashed horizontal lines.</p><div class=plots>\n";
-    for (const auto& [key, label] : figures) {
-      // (scene, variant) -> x -> values
-      std::map<std::pair<std::string, std::string>, std::map<double, std::vector<double>>> groups;
-      std::map<std::pair<std::string, std::string>, std::vector<double>> flat;
-      for (const Row& r : rows) {
-        const double v = Num(r.summary, key);
-        if (!std::isfinite(v)) continue;
-        const auto it = r.point.find(path);
-        if (it != r.point.end())
-          groups[{r.scene, r.variant}][std::strtod(it->second.c_str(), nullptr)].push_back(v);
-        else
-          flat[{r.scene, r.variant}].push_back(v);
-      }
-      std::vector<Series> series;
-      for (const auto& [g, by_x] : groups) {
-        Series s{g.first + ", " + g.second};
-        for (const auto& [x, vs] : by_x) {
-          double sum = 0;
-          for (const double v : vs) sum += v;
-          s.x.push_back(x);
-          s.y.push_back(sum / vs.size());
-          s.y_lo.push_back(*std::min_element(vs.begin(), vs.end()));
-          s.y_hi.push_back(*std::max_element(vs.begin(), vs.end()));
-        }
-        series.push_back(s);
-      }
-      for (const auto& [g, vs] : flat) {
-        double sum = 0;
-        for (const double v : vs) sum += v;
-        Series s{g.first + ", " + g.second};
-        s.x = {x_min, x_max};
-        s.y = {sum / vs.size(), sum / vs.size()};
-        s.dashed = true;
-        series.push_back(s);
-      }
-      if (!series.empty()) h += GnuplotSvg(label, path, label, series);
-    }
-    h += "</div>\n";
-  }
-
-  h += "<h2>Runs</h2><table><tr><th class=l>run</th><th class=l>variant</th>";
-  std::set<std::string> axis_names;
-  for (const auto& a : grid.at("axes")) axis_names.insert(a.at("path").get<std::string>());
-  for (const auto& a : grid.at("axes"))
-    h += "<th class=l>" + Html(a.at("path").get<std::string>()) + "</th>";
-  for (const auto& [key, label] : figures) h += "<th>" + Html(label) + "</th>";
-  h += "</tr>\n";
-  for (const Row& r : rows) {
-    h += "<tr><td class=l><a href=\"runs/" + r.id + "/\">" + r.id + "</a></td><td class=l>" +
-         r.variant + "</td>";
-    for (const auto& a : grid.at("axes")) {
-      const auto it = r.point.find(a.at("path").get<std::string>());
-      h += "<td class=l>" + (it == r.point.end() ? std::string("(base)") : Html(it->second)) +
-           "</td>";
-    }
-    for (const auto& [key, label] : figures) h += "<td>" + Fmt(Num(r.summary, key)) + "</td>";
-    h += "</tr>\n";
-  }
-  h += "</table></body></html>\n";
-  return h;
+       "composite's "
+       "maximum).</p>\n";
+  return h + AxisPlots(grid, rows) + RunsTable(grid, rows) + "</body></html>\n";
 }
 
 }  // namespace

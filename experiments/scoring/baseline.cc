@@ -61,9 +61,9 @@ StaticSgbmResult RunStaticSgbm(rig::Rig& rig, const StaticSgbmOptions& options) 
   r.baseline_m =
       options.baseline_m > 0 ? options.baseline_m : StaticBaseline(rig, options.min_depth_m);
   rig::StageState state = rig.Home();
-  const double centre = 0.5 * (state.left.baseline_m + state.right.baseline_m);
-  state.left.baseline_m = centre - 0.5 * r.baseline_m;
-  state.right.baseline_m = centre + 0.5 * r.baseline_m;
+  const double centre = 0.5 * (state.left.carriage_m + state.right.carriage_m);
+  state.left.carriage_m = centre - 0.5 * r.baseline_m;
+  state.right.carriage_m = centre + 0.5 * r.baseline_m;
   state.left.pan_rad = state.right.pan_rad = 0;
   state.left.tilt_rad = state.right.tilt_rad = 0;
   const rig::MoveResult move = rig.MoveTo(state);

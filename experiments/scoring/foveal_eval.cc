@@ -3,9 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
-#include "experiments/scoring/stats.h"
+#include "fovea/stats.h"
 
 namespace experiments {
+using fovea::Quantile;
 
 FovealScore ScoreFoveal(const fovea::FixationResult& r, const sim::GroundTruth& truth) {
   FovealScore score;

@@ -3,9 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
-#include "experiments/scoring/stats.h"
+#include "fovea/stats.h"
 
 namespace experiments {
+using fovea::Quantile;
 namespace {
 
 // Planar depth where the pixel's ray meets the patch's plane.

@@ -4,10 +4,11 @@
 #include <cmath>
 #include <map>
 
-#include "experiments/scoring/stats.h"
 #include "fovea/geometry.h"
+#include "fovea/stats.h"
 
 namespace experiments {
+using fovea::Quantile;
 namespace {
 
 struct Accumulator {

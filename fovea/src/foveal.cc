@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "fovea/geometry.h"
+#include "fovea/params.h"
 #include "fovea/timing.h"
 #include "rig/left_pair.h"
 
@@ -14,184 +15,235 @@ namespace fovea {
 
 void FovealOptions::Check() const {
   tessellation.Check();
-  if (fovea_patch_px < 3 || periphery_patch_px < 3)
-    throw std::invalid_argument("foveal: patch sizes must be >= 3");
-  if (!(map_margin_px > 0) || !(coarse_margin_px > 0))
-    throw std::invalid_argument("foveal: margins must be positive");
-  if (!(silent_near_m >= 0)) throw std::invalid_argument("foveal: silent_near_m must be >= 0");
+  rig::CheckParam(params::kFovealFoveaPatchPx, fovea_patch_px);
+  rig::CheckParam(params::kFovealPeripheryPatchPx, periphery_patch_px);
+  rig::CheckParam(params::kFovealMapMarginPx, map_margin_px);
+  rig::CheckParam(params::kFovealCoarseMarginPx, coarse_margin_px);
+  rig::CheckParam(params::kFovealSilentConfidence, silent_confidence);
+  plane_fit.Check(params::kFovealFitMinSupport, params::kFovealFitTolerancePx,
+                  params::kFovealFitMinInlierShare);
+  // Set from idr.z_min_m (ResolvedFixationOptions), not a parameter of its own.
+  if (!(silent_near_m >= 0)) throw rig::InputError("foveal options: silent_near_m must be >= 0");
 }
 
 void FixationOptions::Check() const {
   vergence.Check();
   servo.Check();
   foveal.Check();
-  if (!(baseline_m > 0)) throw std::invalid_argument("fixation: baseline_m must be positive");
-  if (!(min_depth_m >= 0)) throw std::invalid_argument("fixation: min_depth_m must be >= 0");
+  rig::CheckParam(params::kFovealBaselineM, baseline_m);
+  // Set from idr.z_min_m (ResolvedFixationOptions), not a parameter of its own.
+  if (!(min_depth_m >= 0)) throw rig::InputError("fixation options: min_depth_m must be >= 0");
 }
+
+namespace {
+
+// One resolution level of the tessellation: its images and geometry.
+struct Level {
+  int index = 0;
+  double scale = 1;  ///< full-resolution pixels per level pixel
+  cv::Mat left, right;
+  cv::Rect rect;  ///< full-resolution pixels it covers
+};
+
+Level MakeLevel(const rig::StereoFrame& frame, const Tessellation& t, int index) {
+  Level l;
+  l.index = index;
+  l.scale = std::pow(2.0, index);
+  l.rect = t.rects[index];
+  if (index == 0) {
+    l.left = frame.left.gray;
+    l.right = frame.right.gray;
+  } else {
+    cv::resize(frame.left.gray, l.left, cv::Size(), 1 / l.scale, 1 / l.scale, cv::INTER_AREA);
+    cv::resize(frame.right.gray, l.right, cv::Size(), 1 / l.scale, 1 / l.scale, cv::INTER_AREA);
+  }
+  return l;
+}
+
+// Per-pixel disparity ranges of one level (lo > hi: not searched): around the
+// coarser level's estimate, else around the map's prediction, else (the map
+// silent) the Z_T band about the fixation depth; `wide` gets, where the map
+// is silent, the range from silent_near_m to infinity as well.
+struct SearchRanges {
+  cv::Mat lo, hi, wide_lo, wide_hi;
+};
+
+SearchRanges LevelRanges(const rig::StereoFrame& frame, const Tessellation& t,
+                         const cv::Mat& map_depth, const cv::Mat* coarse, const Level& level,
+                         const FovealOptions& options) {
+  const rig::CameraView& left = frame.left;
+  const rig::CameraView& right = frame.right;
+  const rig::CameraIntrinsics& k = left.intrinsics;
+  const Eigen::Isometry3d right_T_left = right.world_T_camera.inverse() * left.world_T_camera;
+  const double s = level.scale, z0 = t.fixation_depth_m;
+  auto disparity = [&](double u, double v, double z) {
+    return DisparityAtDepth(left, right, right_T_left, u, v, z) / s;
+  };
+  const cv::Size size = level.left.size();
+  SearchRanges r{cv::Mat(size, CV_32F, cv::Scalar(1)), cv::Mat(size, CV_32F, cv::Scalar(0)),
+                 cv::Mat(size, CV_32F, cv::Scalar(1)), cv::Mat(size, CV_32F, cv::Scalar(0))};
+  for (int y = 0; y < size.height; ++y)
+    for (int x = 0; x < size.width; ++x) {
+      const double u = (x + 0.5) * s - 0.5, v = (y + 0.5) * s - 0.5;
+      const int ui = std::clamp(static_cast<int>(std::lround(u)), 0, k.width_px - 1);
+      const int vi = std::clamp(static_cast<int>(std::lround(v)), 0, k.height_px - 1);
+      if (!level.rect.contains({ui, vi}) || t.mask.at<uchar>(vi, ui) == 0) continue;
+      double dlo, dhi;
+      const float cd = coarse ? coarse->at<float>(std::min(coarse->rows - 1, y / 2),
+                                                  std::min(coarse->cols - 1, x / 2))
+                              : std::numeric_limits<float>::quiet_NaN();
+      const float z = map_depth.at<float>(vi, ui);
+      if (std::isfinite(cd)) {
+        // The coarser level's estimate, in this level's pixels.
+        dlo = 2 * cd - options.coarse_margin_px;
+        dhi = 2 * cd + options.coarse_margin_px;
+      } else if (z > 0) {
+        const double d = disparity(u, v, z);
+        dlo = d - options.map_margin_px;
+        dhi = d + options.map_margin_px;
+      } else {
+        // The map is silent: anything within Z_T of the fixation depth.
+        const double a = disparity(u, v, z0 - t.z_t_near_m), b = disparity(u, v, z0 + t.z_t_far_m);
+        dlo = std::min(a, b) - 1;
+        dhi = std::max(a, b) + 1;
+        if (options.silent_near_m > 0) {
+          const double n = disparity(u, v, options.silent_near_m), f = disparity(u, v, kFarDepthM);
+          if (std::isfinite(n) && std::isfinite(f)) {
+            r.wide_lo.at<float>(y, x) = static_cast<float>(std::min({dlo, n, f}));
+            r.wide_hi.at<float>(y, x) = static_cast<float>(std::max({dhi, n, f}));
+          }
+        }
+      }
+      if (!std::isfinite(dlo) || !std::isfinite(dhi)) continue;
+      r.lo.at<float>(y, x) = static_cast<float>(dlo);
+      r.hi.at<float>(y, x) = static_cast<float>(dhi);
+    }
+  return r;
+}
+
+// A band match where the wide search (every depth from silent_near_m)
+// confidently matched outside Z_T is a false match of a surface the band
+// does not hold: dropped from `dm`. Returns how many.
+int DropOutsideBand(const Level& level, const StereoMatcher& matcher, SearchRanges& ranges,
+                    const FovealOptions& options, DisparityMap* dm) {
+  // Only where the band matched is there anything to drop.
+  for (int y = 0; y < dm->disparity_px.rows; ++y)
+    for (int x = 0; x < dm->disparity_px.cols; ++x)
+      if (!std::isfinite(dm->disparity_px.at<float>(y, x))) {
+        ranges.wide_lo.at<float>(y, x) = 1;  // lo > hi: not searched
+        ranges.wide_hi.at<float>(y, x) = 0;
+      }
+  const DisparityMap wide = matcher.Match(level.left, level.right, ranges.wide_lo, ranges.wide_hi);
+  int dropped = 0;
+  for (int y = 0; y < dm->disparity_px.rows; ++y)
+    for (int x = 0; x < dm->disparity_px.cols; ++x) {
+      float& d = dm->disparity_px.at<float>(y, x);
+      const float w = wide.disparity_px.at<float>(y, x);
+      if (!std::isfinite(d) || !std::isfinite(w) ||
+          wide.confidence.at<float>(y, x) < options.silent_confidence)
+        continue;
+      if (w < ranges.lo.at<float>(y, x) - 1 || w > ranges.hi.at<float>(y, x) + 1) {
+        d = std::numeric_limits<float>::quiet_NaN();
+        ++dropped;
+      }
+    }
+  return dropped;
+}
+
+// Patches over the part of a level the finer one does not cover, each
+// spanning its whole block (blocks that tile the image leave no cracks), its
+// corners triangulated from both rays. Returns how many were added.
+int LevelPatches(const rig::StereoFrame& frame, const Tessellation& t, const Level& level,
+                 const cv::Mat& disparity, const FovealOptions& options, int fixation,
+                 PatchMap* patches) {
+  const rig::CameraView& left = frame.left;
+  const rig::CameraView& right = frame.right;
+  const double s = level.scale;
+  const cv::Rect inner = level.index > 0 ? t.rects[level.index - 1] : cv::Rect();
+  // Peripheral patches keep about the same size in the image at every level
+  // (the paper's were about twice the foveal ones), but never fewer than 4 x
+  // 4 of the level's pixels; their fit tolerance shrinks with the level so
+  // that it stays near a full-resolution pixel and a plane cannot bridge a
+  // depth step.
+  const int size = level.index == 0 ? options.fovea_patch_px
+                                    : std::max(4, options.periphery_patch_px >> level.index);
+  PlaneFitOptions fit_options = options.plane_fit;
+  if (level.index > 0) {
+    fit_options.fit_tolerance_px = std::max(0.25, options.plane_fit.fit_tolerance_px / s);
+    fit_options.min_support = std::min(options.plane_fit.min_support, (3 * size * size) / 4);
+  }
+  int added = 0;
+  for (int by = 0; by + size <= disparity.rows; by += size)
+    for (int bx = 0; bx + size <= disparity.cols; bx += size) {
+      const cv::Point centre(static_cast<int>((bx + 0.5 * size) * s - 0.5),
+                             static_cast<int>((by + 0.5 * size) * s - 0.5));
+      if (!level.rect.contains(centre) || (level.index > 0 && inner.contains(centre))) continue;
+      std::vector<DisparitySample> samples;
+      for (int y = by; y < by + size; ++y)
+        for (int x = bx; x < bx + size; ++x) {
+          const float d = disparity.at<float>(y, x);
+          if (std::isfinite(d)) samples.push_back({double(x), double(y), d});
+        }
+      const auto fit = FitDisparityPlane(samples, bx, by, size, fit_options);
+      if (!fit) continue;
+      Patch p;
+      p.level = level.index == 0 ? PatchLevel::kFoveal : PatchLevel::kPeripheral;
+      p.resolution_level = level.index;
+      p.fixation = fixation;
+      p.fit_rms_px = fit->rms_px;
+      p.support = fit->support;
+      const double xs[4] = {bx - 0.5, bx + size - 0.5, bx + size - 0.5, bx - 0.5};
+      const double ys[4] = {by - 0.5, by - 0.5, by + size - 0.5, by + size - 0.5};
+      bool ok = true;
+      for (int c = 0; c < 4 && ok; ++c) {
+        const double d = (*fit)(xs[c], ys[c]) * s;
+        const double u = (xs[c] + 0.5) * s - 0.5, v = (ys[c] + 0.5) * s - 0.5;
+        const auto tri =
+            TriangulateMidpoint(PixelRay(left.world_T_camera, left.intrinsics, {u, v}),
+                                PixelRay(right.world_T_camera, right.intrinsics, {u - d, v}));
+        ok = tri.has_value();
+        if (ok) p.corners_W[c] = tri->p_W;
+      }
+      if (!ok) continue;
+      patches->Add(p);
+      ++added;
+    }
+  return added;
+}
+
+}  // namespace
 
 FovealResult FovealStereo(const rig::StereoFrame& frame, const Eigen::Vector3d& fixation_W,
                           const PatchMap& map, const StereoMatcher& matcher,
                           const FovealOptions& options, int fixation) {
-  options.Check();
   const auto t_start = Clock::now();
   FovealResult result;
-  const rig::CameraView& left = frame.left;
-  const rig::CameraView& right = frame.right;
-  const rig::CameraIntrinsics& k = left.intrinsics;
-  result.tessellation = Tessellate(left, right, fixation_W, map, options.tessellation);
+  result.tessellation = Tessellate(frame.left, frame.right, fixation_W, map, options.tessellation);
   const Tessellation& t = result.tessellation;
-  const Eigen::Isometry3d right_T_left = right.world_T_camera.inverse() * left.world_T_camera;
   cv::Mat map_depth;
-  map.Render(left.world_T_camera, k, &map_depth, nullptr);
-  const double z0 = t.fixation_depth_m;
-
+  map.Render(frame.left.world_T_camera, frame.left.intrinsics, &map_depth, nullptr);
   const int levels = static_cast<int>(t.rects.size());
   result.disparity_px.resize(levels);
   result.levels.resize(levels);
-  for (int level = levels - 1; level >= 0; --level) {
+  // Coarse to fine: each level's search starts from the coarser one's estimate.
+  for (int index = levels - 1; index >= 0; --index) {
     const auto t0 = Clock::now();
-    const double s = std::pow(2.0, level);
-    cv::Mat l, r;
-    if (level == 0) {
-      l = left.gray;
-      r = right.gray;
-    } else {
-      cv::resize(left.gray, l, cv::Size(), 1 / s, 1 / s, cv::INTER_AREA);
-      cv::resize(right.gray, r, cv::Size(), 1 / s, 1 / s, cv::INTER_AREA);
-    }
-    const cv::Rect& rect = t.rects[level];
-    cv::Mat lo(l.size(), CV_32F, cv::Scalar(1)),
-        hi(l.size(), CV_32F, cv::Scalar(0));  // lo > hi: skip
-    // Where the map is silent: the range from silent_near_m to infinity.
-    cv::Mat wide_lo(l.size(), CV_32F, cv::Scalar(1)), wide_hi(l.size(), CV_32F, cv::Scalar(0));
-    const cv::Mat* coarse = level + 1 < levels ? &result.disparity_px[level + 1] : nullptr;
-    for (int y = 0; y < l.rows; ++y)
-      for (int x = 0; x < l.cols; ++x) {
-        const double u = (x + 0.5) * s - 0.5, v = (y + 0.5) * s - 0.5;
-        const int ui = std::clamp(static_cast<int>(std::lround(u)), 0, k.width_px - 1);
-        const int vi = std::clamp(static_cast<int>(std::lround(v)), 0, k.height_px - 1);
-        if (!rect.contains({ui, vi}) || t.mask.at<uchar>(vi, ui) == 0) continue;
-        double dlo, dhi;
-        const float cd = coarse ? coarse->at<float>(std::min(coarse->rows - 1, y / 2),
-                                                    std::min(coarse->cols - 1, x / 2))
-                                : std::numeric_limits<float>::quiet_NaN();
-        const float z = map_depth.at<float>(vi, ui);
-        if (std::isfinite(cd)) {
-          // The coarser level's estimate, in this level's pixels.
-          dlo = 2 * cd - options.coarse_margin_px;
-          dhi = 2 * cd + options.coarse_margin_px;
-        } else if (z > 0) {
-          const double d = DisparityAtDepth(left, right, right_T_left, u, v, z) / s;
-          dlo = d - options.map_margin_px;
-          dhi = d + options.map_margin_px;
-        } else {
-          // The map is silent: anything within Z_T of the fixation depth.
-          const double a = DisparityAtDepth(left, right, right_T_left, u, v, z0 - t.z_t_near_m) / s;
-          const double b = DisparityAtDepth(left, right, right_T_left, u, v, z0 + t.z_t_far_m) / s;
-          dlo = std::min(a, b) - 1;
-          dhi = std::max(a, b) + 1;
-          if (options.silent_near_m > 0) {
-            const double n =
-                DisparityAtDepth(left, right, right_T_left, u, v, options.silent_near_m) / s;
-            const double f = DisparityAtDepth(left, right, right_T_left, u, v, kFarDepthM) / s;
-            if (std::isfinite(n) && std::isfinite(f)) {
-              wide_lo.at<float>(y, x) = static_cast<float>(std::min({dlo, n, f}));
-              wide_hi.at<float>(y, x) = static_cast<float>(std::max({dhi, n, f}));
-            }
-          }
-        }
-        if (!std::isfinite(dlo) || !std::isfinite(dhi)) continue;
-        lo.at<float>(y, x) = static_cast<float>(dlo);
-        hi.at<float>(y, x) = static_cast<float>(dhi);
-      }
-    DisparityMap dm = matcher.Match(l, r, lo, hi);
-    // A band match where the wide search confidently matched outside Z_T is
-    // a false match of a surface the band does not hold: dropped.
-    int outside_band = 0;
-    if (options.silent_near_m > 0) {
-      // Only where the band matched is there anything to drop.
-      for (int y = 0; y < l.rows; ++y)
-        for (int x = 0; x < l.cols; ++x)
-          if (!std::isfinite(dm.disparity_px.at<float>(y, x))) {
-            wide_lo.at<float>(y, x) = 1;  // lo > hi: not searched
-            wide_hi.at<float>(y, x) = 0;
-          }
-      const DisparityMap wide = matcher.Match(l, r, wide_lo, wide_hi);
-      for (int y = 0; y < l.rows; ++y)
-        for (int x = 0; x < l.cols; ++x) {
-          float& d = dm.disparity_px.at<float>(y, x);
-          const float w = wide.disparity_px.at<float>(y, x);
-          if (!std::isfinite(d) || !std::isfinite(w) ||
-              wide.confidence.at<float>(y, x) < options.silent_confidence)
-            continue;
-          if (w < lo.at<float>(y, x) - 1 || w > hi.at<float>(y, x) + 1) {
-            d = std::numeric_limits<float>::quiet_NaN();
-            ++outside_band;
-          }
-        }
-    }
-    result.disparity_px[level] = dm.disparity_px;
-    LevelFigures& fig = result.levels[level];
-    fig.level = level;
-    fig.rect = rect;
+    const Level level = MakeLevel(frame, t, index);
+    const cv::Mat* coarse = index + 1 < levels ? &result.disparity_px[index + 1] : nullptr;
+    SearchRanges ranges = LevelRanges(frame, t, map_depth, coarse, level, options);
+    DisparityMap dm = matcher.Match(level.left, level.right, ranges.lo, ranges.hi);
+    const int outside_band =
+        options.silent_near_m > 0 ? DropOutsideBand(level, matcher, ranges, options, &dm) : 0;
+    result.disparity_px[index] = dm.disparity_px;
+    LevelFigures& fig = result.levels[index];
+    fig.level = index;
+    fig.rect = level.rect;
     fig.searched = dm.searched;
     fig.matched = dm.matched - outside_band;
     fig.outside_band = outside_band;
     fig.match_time_s = Since(t0);
-
-    // Patches over the part of the level not covered by the finer one.
-    const cv::Rect inner = level > 0 ? t.rects[level - 1] : cv::Rect();
-    // Peripheral patches keep about the same size in the image at every
-    // level (the paper's were about twice the foveal ones), but never fewer
-    // than 4 x 4 of the level's pixels; their fit tolerance shrinks with the
-    // level so that it stays near a full-resolution pixel and a plane cannot
-    // bridge a depth step.
-    const int size =
-        level == 0 ? options.fovea_patch_px : std::max(4, options.periphery_patch_px >> level);
-    PlaneFitOptions fit_options = options.plane_fit;
-    if (level > 0) {
-      fit_options.fit_tolerance_px = std::max(0.25, options.plane_fit.fit_tolerance_px / s);
-      fit_options.min_support = std::min(options.plane_fit.min_support, (3 * size * size) / 4);
-    }
-    for (int by = 0; by + size <= l.rows; by += size)
-      for (int bx = 0; bx + size <= l.cols; bx += size) {
-        const double cu = (bx + 0.5 * size) * s - 0.5, cv_ = (by + 0.5 * size) * s - 0.5;
-        if (!rect.contains({static_cast<int>(cu), static_cast<int>(cv_)})) continue;
-        if (level > 0 && inner.contains({static_cast<int>(cu), static_cast<int>(cv_)})) continue;
-        std::vector<DisparitySample> samples;
-        for (int y = by; y < by + size; ++y)
-          for (int x = bx; x < bx + size; ++x) {
-            const float d = dm.disparity_px.at<float>(y, x);
-            if (std::isfinite(d)) samples.push_back({double(x), double(y), d});
-          }
-        const auto fit = FitDisparityPlane(samples, bx, by, size, fit_options);
-        if (!fit) continue;
-        // The patch spans its whole block: the fit has inliers in all four
-        // quadrants, and blocks that tile the image leave no cracks between
-        // their patches (shrinking to the inliers' extent left gaps of up to
-        // a level pixel, 8 full-resolution pixels at level 3).
-        const double ex0 = bx - 0.5, ey0 = by - 0.5, ex1 = bx + size - 0.5, ey1 = by + size - 0.5;
-        Patch p;
-        p.level = level == 0 ? PatchLevel::kFoveal : PatchLevel::kPeripheral;
-        p.resolution_level = level;
-        p.fixation = fixation;
-        p.fit_rms_px = fit->rms_px;
-        p.support = fit->support;
-        const double xs[4] = {ex0, ex1, ex1, ex0}, ys[4] = {ey0, ey0, ey1, ey1};
-        bool ok = true;
-        for (int c = 0; c < 4 && ok; ++c) {
-          const double d = (*fit)(xs[c], ys[c]) * s;
-          const double u = (xs[c] + 0.5) * s - 0.5, v = (ys[c] + 0.5) * s - 0.5;
-          const auto tri =
-              TriangulateMidpoint(PixelRay(left.world_T_camera, k, {u, v}),
-                                  PixelRay(right.world_T_camera, right.intrinsics, {u - d, v}));
-          ok = tri.has_value();
-          if (ok) p.corners_W[c] = tri->p_W;
-        }
-        if (!ok) continue;
-        result.patches.Add(p);
-        ++fig.patches;
-      }
+    fig.patches =
+        LevelPatches(frame, t, level, dm.disparity_px, options, fixation, &result.patches);
   }
   result.compute_time_s = Since(t_start);
   return result;
@@ -200,7 +252,6 @@ FovealResult FovealStereo(const rig::StereoFrame& frame, const Eigen::Vector3d& 
 FixationResult Fixate(rig::Rig& rig, const PatchMap& map, const Eigen::Vector3d& p_W,
                       const StereoMatcher& matcher, const FixationOptions& options, int fixation,
                       const std::optional<DepthRange>& guessed_depths) {
-  options.Check();
   FixationResult r;
   const auto t0 = Clock::now();
   if (options.choose_placement) {

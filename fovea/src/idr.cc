@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "fovea/params.h"
+#include "fovea/stats.h"
 #include "fovea/timing.h"
 
 namespace fovea {
@@ -39,13 +41,6 @@ int FindUnique(const ZeroCrossing& zc, const ZeroCrossingImage& other, double x_
   }
   if (count <= 1) return found;
   return o.take_nearest_when_ambiguous ? -3 - nearest : -2;
-}
-
-double Quantile(std::vector<double> v, double q) {
-  if (v.empty()) return 0;
-  const size_t k = std::min(v.size() - 1, static_cast<size_t>(q * (v.size() - 1) + 0.5));
-  std::nth_element(v.begin(), v.begin() + k, v.end());
-  return v[k];
 }
 
 }  // namespace
@@ -220,21 +215,30 @@ double ExpansionFactor(double s_min_px, double d_max_px, double focal_px, double
   return s_min_px / (1 + g);
 }
 
+void ZcMatchOptions::Check() const {
+  rig::CheckParam(params::kIdrOrientationToleranceRad, orientation_tolerance_rad);
+}
+
 void IdrOptions::Check() const {
   zero_crossings.Check();
-  auto fail = [](const std::string& m) { throw std::invalid_argument("idr: " + m); };
-  if (!(unique_share > 0 && unique_share < 1)) fail("unique_share must be in (0, 1)");
-  if (!(z_min_m > 0)) fail("z_min_m must be positive");
-  if (!(max_slant_deg >= 0 && max_slant_deg < 89)) fail("max_slant_deg must be in [0, 89)");
-  if (!(min_expansion > 1 && max_expansion >= min_expansion))
-    fail("need 1 < min_expansion <= max_expansion");
-  if (!(vergent_search_px > 0)) fail("vergent_search_px must be positive");
-  if (!(vergent_baseline_m > 0)) fail("vergent_baseline_m must be positive");
-  if (max_stages < 1 || max_stages > 20) fail("max_stages must be 1 to 20");
-  if (patch_size_px < 4 || patch_size_px > 256) fail("patch_size_px must be 4 to 256");
-  if (plane_fit.min_support < 3) fail("plane_fit.min_support must be >= 3");
-  if (!(plane_fit.fit_tolerance_px > 0)) fail("plane_fit.fit_tolerance_px must be positive");
-  if (!(fixed_initial_baseline_m >= 0)) fail("fixed_initial_baseline_m must be >= 0");
+  matching.Check();
+  rig::CheckParam(params::kIdrUniqueShare, unique_share);
+  rig::CheckParam(params::kIdrZMinM, z_min_m);
+  rig::CheckParam(params::kIdrMaxSlantDeg, max_slant_deg);
+  rig::CheckParam(params::kIdrMaxExpansion, max_expansion);
+  rig::CheckParam(params::kIdrMinExpansion, min_expansion);
+  rig::CheckParam(params::kIdrVergentSearchPx, vergent_search_px);
+  rig::CheckParam(params::kIdrVergentBaselineM, vergent_baseline_m);
+  rig::CheckParam(params::kIdrMaxStages, max_stages);
+  rig::CheckParam(params::kIdrPatchSizePx, patch_size_px);
+  rig::CheckParam(params::kIdrDiscontinuityJumpPx, discontinuity_jump_px);
+  rig::CheckParam(params::kIdrInitialBaselineM, fixed_initial_baseline_m);
+  plane_fit.Check(params::kIdrFitMinSupport, params::kIdrFitTolerancePx,
+                  params::kIdrFitMinInlierShare);
+  if (min_expansion > max_expansion)
+    throw rig::InputError("key 'idr.min_expansion': " + rig::FormatParamNumber(min_expansion) +
+                          " exceeds idr.max_expansion (" + rig::FormatParamNumber(max_expansion) +
+                          ")");
 }
 
 PatchMap PatchesFromDisparities(const std::vector<DisparitySample>& samples,
@@ -289,6 +293,139 @@ PatchMap PatchesFromDisparities(const std::vector<DisparitySample>& samples,
   return map;
 }
 
+namespace {
+
+// One stage's matches as samples, the crossings searched but unmatched, and
+// the figures that set the next expansion.
+struct StageSamples {
+  std::vector<DisparitySample> samples;
+  std::vector<Eigen::Vector2d> unmatched;
+};
+
+StageSamples CollectSamples(const ZeroCrossingImage& zc_left, const std::vector<ZcMatch>& matches,
+                            const DisparityWindows& left_windows, double unique_share,
+                            IdrStage* stage) {
+  StageSamples out;
+  out.samples.reserve(matches.size());
+  std::vector<char> matched(zc_left.crossings.size(), 0);
+  for (const ZcMatch& m : matches) matched[m.left] = 1;
+  for (size_t i = 0; i < zc_left.crossings.size(); ++i) {
+    const ZeroCrossing& z = zc_left.crossings[i];
+    double lo, hi;
+    if (!matched[i] && left_windows.Window(z.x_px, z.y_px, &lo, &hi))
+      out.unmatched.emplace_back(z.x_px, z.y_px);
+  }
+  std::vector<double> disparities, separations;
+  const std::vector<float> periods = SamePolarityPeriods(zc_left);
+  for (const ZcMatch& m : matches) {
+    const ZeroCrossing& z = zc_left.crossings[m.left];
+    out.samples.push_back({z.x_px, static_cast<double>(z.y_px), m.disparity_px});
+    disparities.push_back(m.disparity_px);
+    if (std::isfinite(periods[m.left])) separations.push_back(periods[m.left]);
+  }
+  stage->max_disparity_px = Quantile(disparities, 0.99);
+  // s_min: the separation that all but (1 - unique_share) of crossings exceed.
+  stage->min_separation_px = Quantile(separations, 1 - unique_share);
+  return out;
+}
+
+// The samples the patches are fitted to: without isolated wrong matches and
+// without the matches at depth discontinuities.
+std::vector<DisparitySample> SmoothSamples(const std::vector<DisparitySample>& samples,
+                                           const IdrOptions& options) {
+  const double radius = 2 * options.zero_crossings.sigma_px;
+  const std::vector<char> outlier =
+      IsolatedOutliers(samples, radius, options.discontinuity_jump_px);
+  std::vector<DisparitySample> clean;
+  for (size_t i = 0; i < samples.size(); ++i)
+    if (!outlier[i]) clean.push_back(samples[i]);
+  const std::vector<char> at_edge = NearDiscontinuity(clean, radius, options.discontinuity_jump_px);
+  std::vector<DisparitySample> smooth;
+  for (size_t i = 0; i < clean.size(); ++i)
+    if (!at_edge[i]) smooth.push_back(clean[i]);
+  return smooth;
+}
+
+// Candidate first fixation: the well-supported patch nearest the centre.
+void ChooseFirstFixation(const rig::CameraView& left, const IdrOptions& options,
+                         IdrResult* result) {
+  const rig::CameraIntrinsics& k = left.intrinsics;
+  const Eigen::Isometry3d camera_T_world = left.world_T_camera.inverse();
+  double best = 1e300;
+  result->has_fixation = false;
+  for (size_t i = 0; i < result->map.size(); ++i) {
+    const Patch& p = result->map.patches()[i];
+    if (p.support < 2 * options.plane_fit.min_support) continue;
+    const Eigen::Vector3d c_C = camera_T_world * p.Centre();
+    const double r = std::hypot(k.fx_px * c_C.x() / c_C.z(), k.fy_px * c_C.y() / c_C.z());
+    if (r < best) {
+      best = r;
+      result->has_fixation = true;
+      result->first_fixation_W = p.Centre();
+      result->first_fixation_patch = static_cast<int>(i);
+    }
+  }
+}
+
+// The expansion after a stage at baseline b (1 = stop, with the reason in
+// `result`). Termination (section II-C): the IDR depth uncertainty at the
+// fixation, Z^2 0.5 / (f B), within what the vergent stage disambiguates
+// with a +-P px search at its baseline, Z^2 P / (f B_v).
+double NextExpansion(const IdrStage& stage, bool last_stage, bool any_match, double f,
+                     double max_baseline, const IdrOptions& options, IdrResult* result) {
+  const double b = stage.baseline_m;
+  const bool precise_enough = b >= 0.5 * options.vergent_baseline_m / options.vergent_search_px;
+  if (precise_enough && result->has_fixation) {
+    result->stop_reason = "depth precise enough to verge";
+    return 1;
+  }
+  if (last_stage) {
+    result->stop_reason = "stage budget spent";
+    return 1;
+  }
+  if (!any_match) {
+    result->stop_reason = "no matches";
+    return 1;
+  }
+  double expansion = std::min(options.max_expansion,
+                              ExpansionFactor(stage.min_separation_px, stage.max_disparity_px, f,
+                                              options.max_slant_deg * M_PI / 180));
+  expansion = std::min(expansion, max_baseline / b);
+  if (expansion < options.min_expansion) {
+    result->stop_reason =
+        b >= max_baseline - 1e-9 ? "widest baseline reached" : "expansion factor too small";
+    return 1;
+  }
+  return expansion;
+}
+
+// Windows for the next stage: each match predicts k (d +- 0.5), at its left
+// position and at its predicted right position.
+void NextWindows(const std::vector<DisparitySample>& samples, double expansion, int rows,
+                 double min_separation_px, DisparityWindows* left_windows,
+                 DisparityWindows* right_windows) {
+  *left_windows = DisparityWindows();
+  *right_windows = DisparityWindows();
+  left_windows->global = right_windows->global = false;
+  left_windows->rows.assign(rows, {});
+  right_windows->rows.assign(rows, {});
+  left_windows->reach_px = right_windows->reach_px = std::max(2.0, 0.5 * min_separation_px);
+  for (const DisparitySample& m : samples) {
+    const float lo = static_cast<float>(expansion * (m.disparity_px - 0.5));
+    const float hi = static_cast<float>(expansion * (m.disparity_px + 0.5));
+    const int y = static_cast<int>(m.y_px);
+    left_windows->rows[y].push_back({static_cast<float>(m.x_px), lo, hi});
+    right_windows->rows[y].push_back(
+        {static_cast<float>(m.x_px - expansion * m.disparity_px), lo, hi});
+  }
+  for (auto* w : {left_windows, right_windows})
+    for (auto& row : w->rows)
+      std::sort(row.begin(), row.end(),
+                [](const auto& a, const auto& b) { return a.x_px < b.x_px; });
+}
+
+}  // namespace
+
 IdrResult RunIdr(rig::Rig& rig, const IdrOptions& options) {
   options.Check();
   IdrResult result;
@@ -299,14 +436,11 @@ IdrResult RunIdr(rig::Rig& rig, const IdrOptions& options) {
   // the right carriage sets the baseline.
   const double left_x = lb.max;
   const double min_baseline = rb.min - left_x, max_baseline = rb.max - left_x;
-  auto parallel = [&](double baseline) {
-    rig::StageState s;
-    s.left.baseline_m = left_x;
-    s.right.baseline_m = std::clamp(left_x + baseline, rb.min, rb.max);
-    return s;
-  };
   auto move_and_capture = [&](double baseline, IdrStage* stage) {
-    const rig::MoveResult move = rig.MoveTo(parallel(baseline));
+    rig::StageState s;
+    s.left.carriage_m = left_x;
+    s.right.carriage_m = std::clamp(left_x + baseline, rb.min, rb.max);
+    const rig::MoveResult move = rig.MoveTo(s);
     if (stage) stage->motion_time_s = move.motion_time_s;
     result.motion_time_s += move.motion_time_s;
     return rig.Capture();
@@ -316,21 +450,19 @@ IdrResult RunIdr(rig::Rig& rig, const IdrOptions& options) {
   rig::StereoFrame frame = move_and_capture(min_baseline, nullptr);
   const double f = frame.left.intrinsics.fx_px;
   auto t0 = Clock::now();
-  ZeroCrossingImage zc_left = ExtractZeroCrossings(frame.left.gray, options.zero_crossings);
-  const double d_max0 =
-      UnambiguousDisparityLimit(SamePolarityPeriods(zc_left), options.unique_share);
-  double baseline = options.fixed_initial_baseline_m > 0 ? options.fixed_initial_baseline_m
-                                                         : d_max0 * options.z_min_m / f;
-  baseline = std::clamp(baseline, min_baseline, max_baseline);
-  double search_limit =
-      options.fixed_initial_baseline_m > 0 ? f * baseline / options.z_min_m : d_max0;
+  const bool fixed = options.fixed_initial_baseline_m > 0;
+  const double d_max0 = UnambiguousDisparityLimit(
+      SamePolarityPeriods(ExtractZeroCrossings(frame.left.gray, options.zero_crossings)),
+      options.unique_share);
+  const double baseline0 = fixed ? options.fixed_initial_baseline_m : d_max0 * options.z_min_m / f;
+  double baseline = std::clamp(baseline0, min_baseline, max_baseline);
+  const double search_limit = fixed ? f * baseline / options.z_min_m : d_max0;
   result.compute_time_s += Since(t0);
 
   DisparityWindows left_windows, right_windows;
   left_windows.global = right_windows.global = true;
   left_windows.global_lo_px = right_windows.global_lo_px = -0.25;
   left_windows.global_hi_px = right_windows.global_hi_px = search_limit + 0.25;
-
   for (int s = 0; s < options.max_stages; ++s) {
     IdrStage stage;
     frame = move_and_capture(baseline, &stage);
@@ -340,115 +472,26 @@ IdrResult RunIdr(rig::Rig& rig, const IdrOptions& options) {
         (frame.right.world_T_camera.translation() - frame.left.world_T_camera.translation()).norm();
     stage.baseline_m = b;
     stage.search_limit_px = left_windows.global ? left_windows.global_hi_px : 0;
-    zc_left = ExtractZeroCrossings(frame.left.gray, options.zero_crossings);
+    const ZeroCrossingImage zc_left = ExtractZeroCrossings(frame.left.gray, options.zero_crossings);
     const ZeroCrossingImage zc_right =
         ExtractZeroCrossings(frame.right.gray, options.zero_crossings);
     const auto matches = MatchZeroCrossings(zc_left, zc_right, left_windows, right_windows,
                                             options.matching, &stage.stats);
-    std::vector<DisparitySample> samples;
-    samples.reserve(matches.size());
-    std::vector<char> matched(zc_left.crossings.size(), 0);
-    for (const ZcMatch& m : matches) matched[m.left] = 1;
-    std::vector<Eigen::Vector2d> unmatched;
-    for (size_t i = 0; i < zc_left.crossings.size(); ++i) {
-      const ZeroCrossing& z = zc_left.crossings[i];
-      double lo, hi;
-      if (!matched[i] && left_windows.Window(z.x_px, z.y_px, &lo, &hi))
-        unmatched.emplace_back(z.x_px, z.y_px);
-    }
-    std::vector<double> disparities, separations;
-    const std::vector<float> periods = SamePolarityPeriods(zc_left);
-    for (const ZcMatch& m : matches) {
-      const ZeroCrossing& z = zc_left.crossings[m.left];
-      samples.push_back({z.x_px, static_cast<double>(z.y_px), m.disparity_px});
-      disparities.push_back(m.disparity_px);
-      if (std::isfinite(periods[m.left])) separations.push_back(periods[m.left]);
-    }
-    stage.max_disparity_px = Quantile(disparities, 0.99);
-    // s_min: the separation that all but (1 - unique_share) of crossings exceed.
-    stage.min_separation_px = Quantile(separations, 1 - options.unique_share);
-
+    StageSamples stage_samples =
+        CollectSamples(zc_left, matches, left_windows, options.unique_share, &stage);
     result.final_frame = frame;
-    result.final_samples = samples;
-    result.final_unmatched = unmatched;
-    // Drop isolated wrong matches, then the matches at depth discontinuities.
-    const double radius = 2 * options.zero_crossings.sigma_px;
-    const std::vector<char> outlier =
-        IsolatedOutliers(samples, radius, options.discontinuity_jump_px);
-    std::vector<DisparitySample> clean;
-    for (size_t i = 0; i < samples.size(); ++i)
-      if (!outlier[i]) clean.push_back(samples[i]);
-    const std::vector<char> at_edge =
-        NearDiscontinuity(clean, radius, options.discontinuity_jump_px);
-    std::vector<DisparitySample> smooth;
-    for (size_t i = 0; i < clean.size(); ++i)
-      if (!at_edge[i]) smooth.push_back(clean[i]);
-    result.map = PatchesFromDisparities(smooth, frame.left, b, options.patch_size_px,
-                                        options.plane_fit, PatchLevel::kIdr);
-
-    // Candidate first fixation: the well-supported patch nearest the centre.
-    const rig::CameraIntrinsics& k = frame.left.intrinsics;
-    const Eigen::Isometry3d camera_T_world = frame.left.world_T_camera.inverse();
-    double best = 1e300;
-    result.has_fixation = false;
-    for (size_t i = 0; i < result.map.size(); ++i) {
-      const Patch& p = result.map.patches()[i];
-      if (p.support < 2 * options.plane_fit.min_support) continue;
-      const Eigen::Vector3d c_C = camera_T_world * p.Centre();
-      const double r = std::hypot(k.fx_px * c_C.x() / c_C.z(), k.fy_px * c_C.y() / c_C.z());
-      if (r < best) {
-        best = r;
-        result.has_fixation = true;
-        result.first_fixation_W = p.Centre();
-        result.first_fixation_patch = static_cast<int>(i);
-      }
-    }
-
-    // Termination (section II-C): the IDR depth uncertainty at the fixation,
-    // Z^2 0.5 / (f B), within what the vergent stage disambiguates with a
-    // +-P px search at its baseline, Z^2 P / (f B_v).
-    double expansion = 1;
-    const bool precise_enough = b >= 0.5 * options.vergent_baseline_m / options.vergent_search_px;
-    if (precise_enough && result.has_fixation) {
-      result.stop_reason = "depth precise enough to verge";
-    } else if (s + 1 == options.max_stages) {
-      result.stop_reason = "stage budget spent";
-    } else if (matches.empty()) {
-      result.stop_reason = "no matches";
-    } else {
-      expansion = std::min(options.max_expansion,
-                           ExpansionFactor(stage.min_separation_px, stage.max_disparity_px, f,
-                                           options.max_slant_deg * M_PI / 180));
-      expansion = std::min(expansion, max_baseline / b);
-      if (expansion < options.min_expansion) {
-        result.stop_reason =
-            b >= max_baseline - 1e-9 ? "widest baseline reached" : "expansion factor too small";
-        expansion = 1;
-      }
-    }
+    result.final_samples = stage_samples.samples;
+    result.final_unmatched = std::move(stage_samples.unmatched);
+    result.map =
+        PatchesFromDisparities(SmoothSamples(stage_samples.samples, options), frame.left, b,
+                               options.patch_size_px, options.plane_fit, PatchLevel::kIdr);
+    ChooseFirstFixation(frame.left, options, &result);
+    const double expansion = NextExpansion(stage, s + 1 == options.max_stages, !matches.empty(), f,
+                                           max_baseline, options, &result);
     stage.expansion_factor = expansion;
-    if (expansion > 1) {
-      // Windows for the next stage: each match predicts k (d +- 0.5), at its
-      // left position and at its predicted right position.
-      left_windows = DisparityWindows();
-      right_windows = DisparityWindows();
-      left_windows.global = right_windows.global = false;
-      left_windows.rows.assign(frame.left.intrinsics.height_px, {});
-      right_windows.rows.assign(frame.left.intrinsics.height_px, {});
-      left_windows.reach_px = right_windows.reach_px = std::max(2.0, 0.5 * stage.min_separation_px);
-      for (const DisparitySample& m : samples) {
-        const float lo = static_cast<float>(expansion * (m.disparity_px - 0.5));
-        const float hi = static_cast<float>(expansion * (m.disparity_px + 0.5));
-        const int y = static_cast<int>(m.y_px);
-        left_windows.rows[y].push_back({static_cast<float>(m.x_px), lo, hi});
-        right_windows.rows[y].push_back(
-            {static_cast<float>(m.x_px - expansion * m.disparity_px), lo, hi});
-      }
-      for (auto* w : {&left_windows, &right_windows})
-        for (auto& row : w->rows)
-          std::sort(row.begin(), row.end(),
-                    [](const auto& a, const auto& b) { return a.x_px < b.x_px; });
-    }
+    if (expansion > 1)
+      NextWindows(stage_samples.samples, expansion, frame.left.intrinsics.height_px,
+                  stage.min_separation_px, &left_windows, &right_windows);
     stage.compute_time_s = Since(t0);
     result.compute_time_s += stage.compute_time_s;
     result.stages.push_back(stage);

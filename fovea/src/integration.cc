@@ -3,17 +3,16 @@
 #include <stdexcept>
 #include <string>
 
+#include "fovea/params.h"
+
 namespace fovea {
 
 void IntegrationOptions::Check() const {
-  if (!(overlap_share > 0 && overlap_share <= 1))
-    throw std::invalid_argument("integration.overlap_share must be in (0, 1], got " +
-                                std::to_string(overlap_share));
+  rig::CheckParam(params::kIntegrationOverlapShare, overlap_share);
 }
 
 IntegrationStats Integrate(PatchMap* map, const PatchMap& fresh, const rig::CameraView& view,
                            const IntegrationOptions& options) {
-  options.Check();
   IntegrationStats stats;
   stats.offered = static_cast<int>(fresh.size());
   cv::Mat old_ids, new_ids;

@@ -6,13 +6,14 @@
 #include <stdexcept>
 #include <vector>
 
+#include "fovea/params.h"
+
 namespace fovea {
 
 void Nl1Options::Check() const {
-  if (window_half_px < 1 || window_half_px > 20)
-    throw std::invalid_argument("nl1: window_half_px must be 1 to 20");
-  if (!(min_texture_dn >= 0)) throw std::invalid_argument("nl1: min_texture_dn must be >= 0");
-  if (!(lr_tolerance_px > 0)) throw std::invalid_argument("nl1: lr_tolerance_px must be positive");
+  rig::CheckParam(params::kNl1WindowHalfPx, window_half_px);
+  rig::CheckParam(params::kNl1MinTextureDn, min_texture_dn);
+  rig::CheckParam(params::kNl1LrTolerancePx, lr_tolerance_px);
 }
 
 Nl1Matcher::Nl1Matcher(const Nl1Options& options) : options_(options) { options_.Check(); }

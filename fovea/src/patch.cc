@@ -31,6 +31,14 @@ double Patch::SizeM() const {
   return std::max((corners_W[2] - corners_W[0]).norm(), (corners_W[3] - corners_W[1]).norm());
 }
 
+void PlaneFitOptions::Check(const rig::ParamSpec& min_support_spec,
+                            const rig::ParamSpec& fit_tolerance_spec,
+                            const rig::ParamSpec& min_inlier_share_spec) const {
+  rig::CheckParam(min_support_spec, min_support);
+  rig::CheckParam(fit_tolerance_spec, fit_tolerance_px);
+  rig::CheckParam(min_inlier_share_spec, min_inlier_share);
+}
+
 std::optional<PlaneFit> FitDisparityPlane(const std::vector<DisparitySample>& samples, double x0,
                                           double y0, double size, const PlaneFitOptions& options,
                                           Eigen::Vector4d* inlier_box) {

@@ -26,7 +26,7 @@ PlacementRig PlacementRig::Of(const rig::Rig& rig, bool left_pair) {
   r.limits = rig.Limits();
   r.left = rig.Intrinsics(rig::Side::kLeft);
   r.right = rig.Intrinsics(rig::Side::kRight);
-  r.home_left_m = rig.Home().left.baseline_m;
+  r.home_left_m = rig.Home().left.carriage_m;
   r.left_pair = left_pair;
   return r;
 }
@@ -44,14 +44,14 @@ rig::StageState PlaceCarriages(const PlacementRig& rig, double baseline_m, Place
   const rig::RigLimits& limits = rig.limits;
   rig::StageState s = rig::StageState::Parallel(baseline_m);
   if (placement == Placement::kLeftPair) {
-    s.right.baseline_m = rig.home_left_m;
-    s.left.baseline_m = rig.home_left_m - baseline_m;
+    s.right.carriage_m = rig.home_left_m;
+    s.left.carriage_m = rig.home_left_m - baseline_m;
   } else if (placement == Placement::kRightInner) {
-    s.right.baseline_m = limits[rig::Axis::kRightBaseline].min;
-    s.left.baseline_m = s.right.baseline_m - baseline_m;
+    s.right.carriage_m = limits[rig::Axis::kRightBaseline].min;
+    s.left.carriage_m = s.right.carriage_m - baseline_m;
   } else if (placement == Placement::kLeftInner) {
-    s.left.baseline_m = limits[rig::Axis::kLeftBaseline].max;
-    s.right.baseline_m = s.left.baseline_m + baseline_m;
+    s.left.carriage_m = limits[rig::Axis::kLeftBaseline].max;
+    s.right.carriage_m = s.left.carriage_m + baseline_m;
   }
   return s;
 }

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "fovea/geometry.h"
+#include "fovea/params.h"
 
 namespace fovea {
 
@@ -74,6 +75,13 @@ Eigen::Vector3d SelectionContext::MapPoint(int x, int y) const {
 }
 
 cv::Mat LocalSuppression::Evaluate(const SelectionContext& c) const {
+  // Every settled point, and each point aimed at where the servo settled
+  // farther than the revisit radius from it.
+  std::vector<Eigen::Vector3d> points;
+  for (const SelectionContext::Visit& v : c.visits) {
+    points.push_back(v.settled_W);
+    if ((v.aimed_W - v.settled_W).norm() > revisit_) points.push_back(v.aimed_W);
+  }
   cv::Mat w(c.map_level.size(), CV_64F, cv::Scalar(1.0));
   for (int y = 0; y < w.rows; ++y)
     for (int x = 0; x < w.cols; ++x) {
@@ -81,9 +89,9 @@ cv::Mat LocalSuppression::Evaluate(const SelectionContext& c) const {
       double& wp = w.at<double>(y, x);
       if (level == static_cast<signed char>(PatchLevel::kFoveal)) wp = low_;
       if (level == static_cast<signed char>(PatchLevel::kPeripheral)) wp = peripheral_;
-      if (c.fixated_W.empty() || c.map_depth_m.at<float>(y, x) <= 0) continue;
+      if (points.empty() || c.map_depth_m.at<float>(y, x) <= 0) continue;
       const Eigen::Vector3d p = c.MapPoint(x, y);
-      for (const Eigen::Vector3d& f : c.fixated_W) {
+      for (const Eigen::Vector3d& f : points) {
         const double r = (p - f).norm();
         if (r < revisit_) {
           wp = 0;
@@ -121,18 +129,29 @@ cv::Mat Proximity3D::Evaluate(const SelectionContext& c) const {
 }
 
 void SelectionOptions::Check() const {
-  auto bad = [](const std::string& what) { throw std::invalid_argument(what); };
-  if (!(draw_scale > 0)) bad("selection.draw_scale must be > 0, got " + std::to_string(draw_scale));
-  if (histogram_bins < 2 || histogram_bins > 4096)
-    bad("selection.histogram_bins must be 2 to 4096, got " + std::to_string(histogram_bins));
-  if (border_px < 0) bad("selection.border_px must be >= 0, got " + std::to_string(border_px));
-  if (!(refused_radius_m >= 0))
-    bad("selection.refused_radius_m must be >= 0, got " + std::to_string(refused_radius_m));
+  rig::CheckParam(params::kSelectionDrawScale, draw_scale);
+  rig::CheckParam(params::kSelectionHistogramBins, histogram_bins);
+  rig::CheckParam(params::kSelectionBorderPx, border_px);
+  rig::CheckParam(params::kSelectionRefusedRadiusM, refused_radius_m);
 }
 
-std::vector<std::shared_ptr<const FixationCriterion>> FixationSelector::DefaultCriteria() {
-  return {std::make_shared<GradientAttraction>(), std::make_shared<LocalSuppression>(),
-          std::make_shared<Proximity2D>(), std::make_shared<Proximity3D>()};
+void CriteriaOptions::Check() const {
+  rig::CheckParam(params::kCriteriaGradientBlurPx, gradient_blur_px);
+  rig::CheckParam(params::kCriteriaSuppressedWeight, suppressed_weight);
+  rig::CheckParam(params::kCriteriaSuppressionRadiusM, suppression_radius_m);
+  rig::CheckParam(params::kCriteriaPeripheralWeight, peripheral_weight);
+  rig::CheckParam(params::kCriteriaRevisitRadiusM, revisit_radius_m);
+  rig::CheckParam(params::kCriteriaProximity2dScalePx, proximity_2d_scale_px);
+  rig::CheckParam(params::kCriteriaProximity3dLow, proximity_3d_low);
+}
+
+std::vector<std::shared_ptr<const FixationCriterion>> CriteriaOptions::Make() const {
+  std::vector<std::shared_ptr<const FixationCriterion>> c;
+  if (gradient) c.push_back(std::make_shared<GradientAttraction>(*this));
+  if (suppression) c.push_back(std::make_shared<LocalSuppression>(*this));
+  if (proximity_2d) c.push_back(std::make_shared<Proximity2D>(*this));
+  if (proximity_3d) c.push_back(std::make_shared<Proximity3D>(*this));
+  return c;
 }
 
 FixationSelector::FixationSelector(std::vector<std::shared_ptr<const FixationCriterion>> criteria,

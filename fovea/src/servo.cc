@@ -5,22 +5,18 @@
 #include <stdexcept>
 
 #include "fovea/geometry.h"
+#include "fovea/params.h"
 
 namespace fovea {
 
 void ServoOptions::Check() const {
-  if (window_half_px < 2 || window_half_px > 100)
-    throw std::invalid_argument("servo: window_half_px must be 2 to 100");
-  if (search_px < 1 || search_px > 300)
-    throw std::invalid_argument("servo: search_px must be 1 to 300");
-  if (refine_px < 1 || refine_px > 300)
-    throw std::invalid_argument("servo: refine_px must be 1 to 300");
-  if (!(tolerance_px > 0)) throw std::invalid_argument("servo: tolerance_px must be positive");
-  if (max_steps < 1) throw std::invalid_argument("servo: max_steps must be >= 1");
-  if (!(unique_ratio > 0 && unique_ratio <= 1))
-    throw std::invalid_argument("servo: unique_ratio must be in (0, 1]");
-  if (!(mutual_tolerance_px >= 0))
-    throw std::invalid_argument("servo: mutual_tolerance_px must be >= 0");
+  rig::CheckParam(params::kFovealServoWindowHalfPx, window_half_px);
+  rig::CheckParam(params::kFovealServoSearchPx, search_px);
+  rig::CheckParam(params::kFovealServoRefinePx, refine_px);
+  rig::CheckParam(params::kFovealServoTolerancePx, tolerance_px);
+  rig::CheckParam(params::kFovealServoMaxSteps, max_steps);
+  rig::CheckParam(params::kFovealServoUniqueRatio, unique_ratio);
+  rig::CheckParam(params::kFovealServoMutualPx, mutual_tolerance_px);
 }
 
 double NormalizedL1(const cv::Mat& left, int xl, int yl, const cv::Mat& right, int xr, int yr,
@@ -141,7 +137,6 @@ std::optional<double> CentreDisparity(const rig::StereoFrame& frame, const Servo
 
 ServoResult Servo(rig::Rig& rig, const rig::StageState& start, const ServoOptions& o,
                   const std::optional<DepthRange>& first_depths) {
-  o.Check();
   ServoResult result;
   rig::StageState state = start;
   result.motion_time_s += rig.MoveTo(state).motion_time_s;

@@ -7,7 +7,19 @@
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "fovea/params.h"
+#include "rig/input_file.h"
+
 namespace fovea {
+
+void SgbmOptions::Check() const {
+  rig::CheckParam(params::kSgbmBlockSize, block_size);
+  if (block_size % 2 == 0)
+    throw rig::InputError("key 'sgbm.block_size': " + std::to_string(block_size) + " is not odd");
+  rig::CheckParam(params::kSgbmUniquenessRatio, uniqueness_ratio);
+  rig::CheckParam(params::kSgbmSpeckleWindow, speckle_window);
+  rig::CheckParam(params::kSgbmSpeckleRange, speckle_range);
+}
 namespace {
 
 cv::Ptr<cv::StereoSGBM> Make(const SgbmOptions& o, int min_d, int num_d) {

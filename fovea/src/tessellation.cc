@@ -3,13 +3,13 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "fovea/params.h"
+
 namespace fovea {
 
 void TessellationOptions::Check() const {
-  if (!(horizontal_disparity_limit_px > 0))
-    throw std::invalid_argument("tessellation: horizontal_disparity_limit_px must be positive");
-  if (max_levels < 1 || max_levels > 6)
-    throw std::invalid_argument("tessellation: max_levels must be 1 to 6");
+  rig::CheckParam(params::kFovealHorizontalDisparityLimitPx, horizontal_disparity_limit_px);
+  rig::CheckParam(params::kFovealMaxLevels, max_levels);
 }
 
 int Tessellation::LevelAt(int u, int v) const {
@@ -49,7 +49,6 @@ double AxisHorizontalDisparity(const rig::CameraView& left, const rig::CameraVie
 Tessellation Tessellate(const rig::CameraView& left, const rig::CameraView& right,
                         const Eigen::Vector3d& fixation_W, const PatchMap& map,
                         const TessellationOptions& options) {
-  options.Check();
   Tessellation t;
   const rig::CameraIntrinsics& k = left.intrinsics;
   t.fixation_depth_m = (left.world_T_camera.inverse() * fixation_W).z();

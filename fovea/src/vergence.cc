@@ -4,12 +4,14 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "fovea/params.h"
+
 namespace fovea {
 
 void VergenceOptions::Check() const {
-  if (max_iterations < 1) throw std::invalid_argument("vergence: max_iterations must be >= 1");
-  if (!(tolerance_px > 0)) throw std::invalid_argument("vergence: tolerance_px must be positive");
-  if (!(min_distance_m >= 0)) throw std::invalid_argument("vergence: min_distance_m must be >= 0");
+  rig::CheckParam(params::kFovealVergenceMaxIterations, max_iterations);
+  rig::CheckParam(params::kFovealVergenceTolerancePx, tolerance_px);
+  rig::CheckParam(params::kFovealVergenceMinDistanceM, min_distance_m);
 }
 
 namespace {
@@ -29,20 +31,19 @@ VergenceSolution Verge(const rig::RigGeometry& g, const rig::RigLimits& limits,
                        const rig::CameraIntrinsics& left, const rig::CameraIntrinsics& right,
                        const rig::StageState& baselines, const Eigen::Vector3d& p_W,
                        const VergenceOptions& options) {
-  options.Check();
   VergenceSolution sol;
   sol.state = baselines;
   for (rig::Side side : {rig::Side::kLeft, rig::Side::kRight}) {
     const rig::CameraIntrinsics& k = side == rig::Side::kLeft ? left : right;
     rig::CameraStage& stage = sol.state[side];
-    const Eigen::Vector3d v = p_W - g.WorldFromHead(side, {stage.baseline_m, 0, 0}).translation();
+    const Eigen::Vector3d v = p_W - g.WorldFromHead(side, {stage.carriage_m, 0, 0}).translation();
     if (v.norm() < options.min_distance_m) {
       sol.why = std::string(rig::SideName(side)) + " camera: point nearer than " +
                 std::to_string(options.min_distance_m) + " m";
       return sol;
     }
     // Start: the optical centre on the axes.
-    stage = g.FacingStage(side, stage.baseline_m, p_W);
+    stage = g.FacingStage(side, stage.carriage_m, p_W);
     // Newton on the normalized projection (x/z, y/z) -> 0.
     double z = 0;
     for (int it = 0; it < options.max_iterations; ++it) {

@@ -6,16 +6,16 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "fovea/params.h"
+
 namespace fovea {
 
 void ZeroCrossingOptions::Check() const {
-  if (!(sigma_px >= 0.5 && sigma_px <= 20))
-    throw std::invalid_argument("zero crossings: sigma_px must be in [0.5, 20]");
-  if (!(min_slope >= 0)) throw std::invalid_argument("zero crossings: min_slope must be >= 0");
+  rig::CheckParam(params::kIdrLogSigmaPx, sigma_px);
+  rig::CheckParam(params::kIdrLogMinSlope, min_slope);
 }
 
 ZeroCrossingImage ExtractZeroCrossings(const cv::Mat& gray, const ZeroCrossingOptions& options) {
-  options.Check();
   CV_Assert(gray.type() == CV_8UC1);
   ZeroCrossingImage out;
   cv::Mat f, blurred;

@@ -16,7 +16,7 @@ Eigen::Matrix3d HeadFromCameraRotation() {
 Eigen::Isometry3d RigGeometry::WorldFromHead(Side side, const CameraStage& stage) const {
   const HeadGeometry& head = (*this)[side];
   Eigen::Isometry3d world_T_head = Eigen::Isometry3d::Identity();
-  world_T_head.translation() = head.rail_zero_W + stage.baseline_m * Eigen::Vector3d::UnitX();
+  world_T_head.translation() = head.rail_zero_W + stage.carriage_m * Eigen::Vector3d::UnitX();
   world_T_head.linear() = (Eigen::AngleAxisd(stage.pan_rad, Eigen::Vector3d::UnitZ()) *
                            Eigen::AngleAxisd(stage.tilt_rad, Eigen::Vector3d::UnitX()))
                               .toRotationMatrix();

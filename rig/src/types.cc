@@ -110,8 +110,8 @@ cv::Matx33d CameraIntrinsics::K() const {
 
 StageState StageState::Parallel(double baseline_m) {
   StageState s;
-  s.left.baseline_m = -0.5 * baseline_m;
-  s.right.baseline_m = 0.5 * baseline_m;
+  s.left.carriage_m = -0.5 * baseline_m;
+  s.right.carriage_m = 0.5 * baseline_m;
   return s;
 }
 
@@ -123,8 +123,8 @@ StageState StageState::FromArray(const std::array<double, kNumAxes>& v) {
 }
 
 std::array<double, kNumAxes> StageState::ToArray() const {
-  return {left.baseline_m,  left.pan_rad,  left.tilt_rad,
-          right.baseline_m, right.pan_rad, right.tilt_rad};
+  return {left.carriage_m,  left.pan_rad,  left.tilt_rad,
+          right.carriage_m, right.pan_rad, right.tilt_rad};
 }
 
 std::string StageState::ToString() const {
@@ -132,8 +132,8 @@ std::string StageState::ToString() const {
   std::snprintf(buf, sizeof buf,
                 "left(x=%.5f m, pan=%.4f deg, tilt=%.4f deg) right(x=%.5f m, pan=%.4f deg, "
                 "tilt=%.4f deg)",
-                left.baseline_m, left.pan_rad * 180 / M_PI, left.tilt_rad * 180 / M_PI,
-                right.baseline_m, right.pan_rad * 180 / M_PI, right.tilt_rad * 180 / M_PI);
+                left.carriage_m, left.pan_rad * 180 / M_PI, left.tilt_rad * 180 / M_PI,
+                right.carriage_m, right.pan_rad * 180 / M_PI, right.tilt_rad * 180 / M_PI);
   return buf;
 }
 

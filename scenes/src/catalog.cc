@@ -19,18 +19,39 @@ std::string ScenesDir() {
   return FOVEA_SCENES_SOURCE_DIR;
 }
 
-std::string ResolveScene(const std::string& name_or_path) {
+SceneSource SceneSource::Parse(const std::string& name_or_path) {
+  SceneSource source;
+  source.name = name_or_path;
+  source.path = name_or_path;
   if (name_or_path.find('/') != std::string::npos ||
       std::filesystem::path(name_or_path).extension() == ".xml") {
-    return name_or_path;
+    source.kind = Kind::kFile;
+    return source;
   }
-  if (ParseRandomSceneName(name_or_path)) return name_or_path;
+  if (const auto spec = ParseRandomSceneName(name_or_path)) {
+    source.kind = Kind::kRandom;
+    source.random = *spec;
+    return source;
+  }
   for (const auto& name : CatalogNames())
-    if (name == name_or_path) return ScenesDir() + "/" + name + ".xml";
+    if (name == name_or_path) {
+      source.kind = Kind::kCatalog;
+      source.path = ScenesDir() + "/" + name + ".xml";
+      return source;
+    }
   std::string names;
   for (const auto& name : CatalogNames()) names += (names.empty() ? "" : ", ") + name;
   throw sim::SceneError("unknown scene '" + rig::ClipForMessage(name_or_path) +
                         "' (catalog: " + names + "; or give a path to an .xml file)");
+}
+
+void SceneSource::CheckReadable() const {
+  if (kind == Kind::kRandom) return;
+  try {
+    rig::CheckInputFile(path, "scene file");
+  } catch (const rig::InputError& e) {
+    throw sim::SceneError(e.what());
+  }
 }
 
 sim::AssetProvider TextureProvider() {
@@ -49,10 +70,11 @@ sim::AssetProvider TextureProvider() {
 
 std::unique_ptr<sim::Simulation> LoadScene(const std::string& name_or_path,
                                            const sim::SimRigConfig& config) {
-  const std::string resolved = ResolveScene(name_or_path);
-  if (auto spec = ParseRandomSceneName(resolved))
-    return sim::Simulation::LoadText(resolved, RandomSceneXml(*spec), config, TextureProvider());
-  return sim::Simulation::Load(resolved, config, TextureProvider());
+  const SceneSource source = SceneSource::Parse(name_or_path);
+  if (source.kind == SceneSource::Kind::kRandom)
+    return sim::Simulation::LoadText(source.name, RandomSceneXml(source.random), config,
+                                     TextureProvider());
+  return sim::Simulation::Load(source.path, config, TextureProvider());
 }
 
 }  // namespace scenes

@@ -8,29 +8,36 @@
 namespace sim {
 
 void NoiseConfig::Check() const {
-  if (!(read_noise_sigma_dn >= 0)) throw SceneError("noise.read_noise_sigma_dn must be >= 0");
-  if (!(blur_sigma_px >= 0)) throw SceneError("noise.blur_sigma_px must be >= 0");
+  rig::CheckParam(params::kNoiseSigmaDn, read_noise_sigma_dn);
+  rig::CheckParam(params::kBlurSigmaPx, blur_sigma_px);
 }
 
 void SimRigConfig::Check() const {
-  auto fail = [](const std::string& what) { throw SceneError("rig config: " + what); };
-  if (width_px < 16 || height_px < 16 || width_px > 4096 || height_px > 4096)
-    fail("image size must be within 16 to 4096 pixels per side");
-  if (!(horizontal_fov_deg > 1 && horizontal_fov_deg < 120))
-    fail("horizontal_fov_deg must be in (1, 120)");
-  if (!optical_centre_offset_m.allFinite() || optical_centre_offset_m.norm() > 0.2)
-    fail("optical_centre_offset_m must be finite and under 0.2 m");
-  if (!(carriage_min_m >= 0 && carriage_max_m > carriage_min_m && carriage_max_m <= 2))
-    fail("carriage travel must satisfy 0 <= carriage_min_m < carriage_max_m <= 2");
-  if (!(home_baseline_m >= 2 * carriage_min_m && home_baseline_m <= 2 * carriage_max_m))
-    fail("home_baseline_m must lie within the carriages' travel");
-  if (!(pan_limit_deg > 0 && pan_limit_deg < 180)) fail("pan_limit_deg must be in (0, 180)");
-  if (!(tilt_limit_deg > 0 && tilt_limit_deg < 90)) fail("tilt_limit_deg must be in (0, 90)");
-  if (!(baseline_steps_per_mm > 0) || !(pan_tilt_steps_per_deg > 0))
-    fail("steps per unit must be positive");
-  if (!(settle_tolerance_steps >= 0.5)) fail("settle_tolerance_steps must be >= 0.5");
-  if (!(move_timeout_s > 0)) fail("move_timeout_s must be positive");
+  rig::CheckParam(params::kWidthPx, width_px);
+  rig::CheckParam(params::kHeightPx, height_px);
+  rig::CheckParam(params::kHorizontalFovDeg, horizontal_fov_deg);
+  rig::CheckParam(params::kOpticalCentreXM, optical_centre_offset_m.x());
+  rig::CheckParam(params::kOpticalCentreYM, optical_centre_offset_m.y());
+  rig::CheckParam(params::kOpticalCentreZM, optical_centre_offset_m.z());
+  rig::CheckParam(params::kCarriageMinM, carriage_min_m);
+  rig::CheckParam(params::kCarriageMaxM, carriage_max_m);
+  rig::CheckParam(params::kHomeBaselineM, home_baseline_m);
+  rig::CheckParam(params::kPanLimitDeg, pan_limit_deg);
+  rig::CheckParam(params::kTiltLimitDeg, tilt_limit_deg);
+  rig::CheckParam(params::kBaselineStepsPerMm, baseline_steps_per_mm);
+  rig::CheckParam(params::kPanTiltStepsPerDeg, pan_tilt_steps_per_deg);
+  rig::CheckParam(params::kSettleToleranceSteps, settle_tolerance_steps);
+  rig::CheckParam(params::kMoveTimeoutS, move_timeout_s);
   noise.Check();
+  // What single ranges cannot say: the parts against each other.
+  const std::string widest = rig::FormatParamNumber(2 * carriage_max_m);
+  if (!(carriage_max_m > carriage_min_m))
+    throw rig::InputError("key 'rig.carriage_max_m': must exceed rig.carriage_min_m");
+  if (home_baseline_m < 2 * carriage_min_m || home_baseline_m > 2 * carriage_max_m)
+    throw rig::InputError("key 'rig.home_baseline_m': " + rig::FormatParamNumber(home_baseline_m) +
+                          " is not within the carriages' travel (2 x rig.carriage_min_m to 2 x "
+                          "rig.carriage_max_m = " +
+                          widest + ")");
 }
 
 std::string RigMjcf(const SimRigConfig& c) {

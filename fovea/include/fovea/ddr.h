@@ -16,31 +16,16 @@
 #include "fovea/idr.h"
 #include "fovea/integration.h"
 #include "fovea/selection.h"
+#include "fovea/sgbm.h"
 #include "rig/rig.h"
 
 namespace fovea {
 
-/// Which criteria the selector multiplies (all on: the paper's rule).
-struct CriteriaOptions {
-  bool gradient = true;
-  bool suppression = true;
-  bool proximity_2d = true;
-  bool proximity_3d = true;
-  double gradient_blur_px = 2.0;
-  double suppressed_weight = 0.02;     ///< local suppression's weight on foveal data
-  double suppression_radius_m = 0.08;  ///< and within this distance of an earlier fixation
-  double peripheral_weight = 0.3;      ///< local suppression's weight on peripheral data (paper: 1)
-  double revisit_radius_m =
-      0.03;  ///< local suppression's weight is 0 this close to an earlier fixation
-  double proximity_2d_scale_px = 320;
-  double proximity_3d_low = 0.1;  ///< 3D proximity's weight outside the Z_T band
-  void Check() const;
-  std::vector<std::shared_ptr<const FixationCriterion>> Make() const;
-};
-
 struct FoveaOptions {
   IdrOptions idr;
   FixationOptions fixation;
+  Nl1Options nl1;    ///< the NL1 per-level matcher's (MakeMatcher)
+  SgbmOptions sgbm;  ///< the StereoSGBM per-level matcher's (MakeMatcher)
   SelectionOptions selection;
   CriteriaOptions criteria;
   IntegrationOptions integration;
@@ -63,8 +48,20 @@ struct FoveaOptions {
   /// always ends.
   int attempts_per_fixation = 3;
   uint64_t seed = 0;   ///< the one generator's seed
-  void Check() const;  ///< throws std::invalid_argument naming the field
+  void Check() const;  ///< throws rig::InputError naming the key (fovea/params.h)
 };
+
+/// The options every fixation of a run uses, resolved once from the run's:
+/// nothing lies nearer than idr.z_min_m, so a servo settling nearer is
+/// refused (FixationOptions::min_depth_m) and, with silent_check, the
+/// fovea's wider search where the map is silent starts there
+/// (FovealOptions::silent_near_m). RunFovea, `fovea fixate` and `fovea bench
+/// fixation` all fixate with it.
+FixationOptions ResolvedFixationOptions(const FoveaOptions& options);
+
+/// The per-level matcher a run names ("nl1" or "sgbm"), with the run's
+/// options for it. Throws rig::InputError for another name.
+std::unique_ptr<StereoMatcher> MakeMatcher(const std::string& name, const FoveaOptions& options);
 
 /// Wall-clock seconds by stage of one fixation.
 struct StageTimes {

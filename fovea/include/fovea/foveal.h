@@ -35,10 +35,11 @@ struct FovealOptions {
   /// and a band match is dropped where that wider search matched outside the
   /// band with at least `silent_confidence` (a repeated texture's copies
   /// leave its confidence low: the band's prior stands). RunFovea sets it
-  /// to idr.z_min_m (FoveaOptions::silent_check).
-  double silent_near_m = 0.4;
+  /// to idr.z_min_m (FoveaOptions::silent_check, ResolvedFixationOptions);
+  /// 0: the paper's band search only.
+  double silent_near_m = 0;
   double silent_confidence = 0.2;
-  void Check() const;
+  void Check() const;  ///< throws rig::InputError naming the key (fovea/params.h)
 };
 
 /// Figures of one resolution level.
@@ -62,6 +63,8 @@ struct FovealResult {
 /// Matches a verged pair that fixates p_W, level by level, coarse to fine,
 /// with the range at each pixel bounded by `map` (or by Z_T where the map is
 /// silent), and fits patches: `fixation` is recorded in each patch.
+/// `options` must have passed Check(): the run checks them once, before
+/// its work (RunFovea, RunIdr, RunConfig::Check), never per call.
 FovealResult FovealStereo(const rig::StereoFrame& frame, const Eigen::Vector3d& fixation_W,
                           const PatchMap& map, const StereoMatcher& matcher,
                           const FovealOptions& options, int fixation = 0);
@@ -86,7 +89,7 @@ struct FixationOptions {
   /// servo that settles nearer took a false match (a repeated texture's
   /// copy) and the point is refused before any matching (0: no check).
   double min_depth_m = 0;
-  void Check() const;
+  void Check() const;  ///< throws rig::InputError naming the key (fovea/params.h)
 };
 
 struct FixationResult {
@@ -108,6 +111,8 @@ struct FixationResult {
 /// servo's first search spans those depths, and a servo that does not
 /// converge leaves the point not fixable (the foveated stage would search
 /// around a depth nobody measured).
+/// `options` must have passed Check(): the run checks them once, before
+/// its work (RunFovea, RunIdr, RunConfig::Check), never per call.
 FixationResult Fixate(rig::Rig& rig, const PatchMap& map, const Eigen::Vector3d& p_W,
                       const StereoMatcher& matcher, const FixationOptions& options,
                       int fixation = 0,

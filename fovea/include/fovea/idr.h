@@ -36,6 +36,7 @@ struct ZcMatchOptions {
   /// matchers instead take the candidate of smallest disparity; that policy
   /// is here for comparison (it turns ambiguity into wrong matches).
   bool take_nearest_when_ambiguous = false;
+  void Check() const;  ///< throws rig::InputError naming the key (fovea/params.h)
 };
 
 /// Figures of one matching pass (counts of left crossings unless named).
@@ -112,7 +113,7 @@ struct IdrOptions {
   /// Fixed initial baseline instead of the period rule (0 = use the rule);
   /// for experiments that show why the rule matters.
   double fixed_initial_baseline_m = 0;
-  void Check() const;  ///< throws std::invalid_argument naming the field
+  void Check() const;  ///< throws rig::InputError naming the key (fovea/params.h)
 };
 
 /// Figures of one baseline stage, for the experiment harness.

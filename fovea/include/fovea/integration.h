@@ -14,7 +14,7 @@ struct IntegrationOptions {
   /// patch is removed when at least this share of its visible footprint is
   /// covered by kept new patches of its level or finer.
   double overlap_share = 0.9;
-  void Check() const;  ///< throws std::invalid_argument naming the field
+  void Check() const;  ///< throws rig::InputError naming the key (fovea/params.h)
 };
 
 struct IntegrationStats {
@@ -31,6 +31,8 @@ struct IntegrationStats {
 /// refine "peripheral replaces peripheral": a coarser resolution level does
 /// not replace a finer one (Patch::Fineness). Cost:
 /// two renders into the view, O(N + M + pixels) for N old and M new patches.
+/// `options` must have passed Check(): the run checks them once, before
+/// its work (RunFovea, RunIdr, RunConfig::Check), never per call.
 IntegrationStats Integrate(PatchMap* map, const PatchMap& fresh, const rig::CameraView& view,
                            const IntegrationOptions& options = {});
 

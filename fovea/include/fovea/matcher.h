@@ -29,7 +29,7 @@ struct Nl1Options {
   int window_half_px = 3;        ///< a 7 x 7 window
   double min_texture_dn = 2.0;   ///< mean absolute deviation of the left window
   double lr_tolerance_px = 1.0;  ///< left-right check
-  void Check() const;
+  void Check() const;            ///< throws rig::InputError naming the key (fovea/params.h)
 };
 
 /// Normalized L1 window matching (the paper's cost: sum |(L - mean L) - (R -

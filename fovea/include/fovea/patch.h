@@ -8,6 +8,7 @@
 #include <optional>
 #include <vector>
 
+#include "rig/param.h"
 #include "rig/types.h"
 
 namespace fovea {
@@ -57,6 +58,10 @@ struct PlaneFitOptions {
   /// patch never extrapolates over a part of the block it has no data for
   /// (for instance the other side of a depth step).
   bool require_quadrants = true;
+  /// Throws rig::InputError naming the key, against the specs of the fit it
+  /// serves (IDR's or the fovea's, fovea/params.h).
+  void Check(const rig::ParamSpec& min_support_spec, const rig::ParamSpec& fit_tolerance_spec,
+             const rig::ParamSpec& min_inlier_share_spec) const;
 };
 
 /// One measurement: a disparity at a (sub-pixel) image position.

@@ -30,8 +30,13 @@ struct SelectionContext {
   bool has_fixation = false;             ///< false before the first vergent fixation
   double fixation_depth_m = 0;           ///< depth of the current fixation point in the view
   double z_t_near_m = 0, z_t_far_m = 0;  ///< the current fovea's depth band (Z_T)
-  std::vector<Eigen::Vector3d>
-      fixated_W;  ///< earlier fixation points (and holes' guessed points aimed at)
+  /// An earlier fixation: where the servo settled, and the point aimed at
+  /// (which stays unmapped when the servo settled elsewhere: a hole's
+  /// guessed depth, a false match).
+  struct Visit {
+    Eigen::Vector3d settled_W, aimed_W;
+  };
+  std::vector<Visit> visits;
   /// If set, only points that this view sees (the IDR view: the region the
   /// run maps) are candidates.
   std::optional<rig::CameraView> region;
@@ -47,6 +52,28 @@ struct SelectionContext {
                                const PatchMap& map, bool fill_holes = false);
 };
 
+class FixationCriterion;
+
+/// Which criteria the selector multiplies (all on: the paper's rule) and
+/// their settings (fovea/params.h, "criteria.").
+struct CriteriaOptions {
+  bool gradient = true;
+  bool suppression = true;
+  bool proximity_2d = true;
+  bool proximity_3d = true;
+  double gradient_blur_px = 2.0;
+  double suppressed_weight = 0.02;     ///< local suppression's weight on foveal data
+  double suppression_radius_m = 0.08;  ///< and within this distance of an earlier fixation
+  double peripheral_weight = 0.3;      ///< local suppression's weight on peripheral data (paper: 1)
+  /// Local suppression's weight is 0 this close to an earlier fixation point.
+  double revisit_radius_m = 0.03;
+  double proximity_2d_scale_px = 320;
+  double proximity_3d_low = 0.1;  ///< 3D proximity's weight outside the Z_T band
+  void Check() const;             ///< throws rig::InputError naming the key (fovea/params.h)
+  /// The criteria switched on, each with its settings from here.
+  std::vector<std::shared_ptr<const FixationCriterion>> Make() const;
+};
+
 /// One criterion: a non-negative weight per pixel (CV_64F, the view's size)
 /// that sums to 1 over the image (or is all zero if nothing qualifies).
 class FixationCriterion {
@@ -60,7 +87,7 @@ class FixationCriterion {
 /// averaged over a window of the same scale): attracts the eye to texture.
 class GradientAttraction : public FixationCriterion {
  public:
-  explicit GradientAttraction(double blur_sigma_px = 2.0) : sigma_(blur_sigma_px) {}
+  explicit GradientAttraction(const CriteriaOptions& o) : sigma_(o.gradient_blur_px) {}
   std::string Name() const override { return "gradient"; }
   cv::Mat Evaluate(const SelectionContext& context) const override;
 
@@ -69,7 +96,7 @@ class GradientAttraction : public FixationCriterion {
 };
 
 /// Low weight where the map already holds foveal data or lies within
-/// `radius_m` of an earlier fixation point (a fixation whose fovea yielded
+/// `suppression_radius_m` of an earlier fixation point (a fixation whose fovea yielded
 /// no patches, at a depth edge say, must not attract the eye forever), high
 /// elsewhere. Beyond the paper, `peripheral_weight` grades the suppression:
 /// the weight where the map holds peripheral data (1 = the paper's rule, which
@@ -81,12 +108,11 @@ class GradientAttraction : public FixationCriterion {
 /// weight above 0).
 class LocalSuppression : public FixationCriterion {
  public:
-  explicit LocalSuppression(double suppressed_weight = 0.02, double radius_m = 0.04,
-                            double peripheral_weight = 1.0, double revisit_radius_m = 0)
-      : low_(suppressed_weight),
-        radius_(radius_m),
-        peripheral_(peripheral_weight),
-        revisit_(revisit_radius_m) {}
+  explicit LocalSuppression(const CriteriaOptions& o)
+      : low_(o.suppressed_weight),
+        radius_(o.suppression_radius_m),
+        peripheral_(o.peripheral_weight),
+        revisit_(o.revisit_radius_m) {}
   std::string Name() const override { return "suppression"; }
   cv::Mat Evaluate(const SelectionContext& context) const override;
 
@@ -97,7 +123,7 @@ class LocalSuppression : public FixationCriterion {
 /// exp(-r / s), r the distance from the image centre in pixels.
 class Proximity2D : public FixationCriterion {
  public:
-  explicit Proximity2D(double scale_px = 160) : scale_(scale_px) {}
+  explicit Proximity2D(const CriteriaOptions& o) : scale_(o.proximity_2d_scale_px) {}
   std::string Name() const override { return "proximity_2d"; }
   cv::Mat Evaluate(const SelectionContext& context) const override;
 
@@ -109,7 +135,7 @@ class Proximity2D : public FixationCriterion {
 /// Z_T band, low elsewhere (uniform before the first vergent fixation).
 class Proximity3D : public FixationCriterion {
  public:
-  explicit Proximity3D(double low_weight = 0.1) : low_(low_weight) {}
+  explicit Proximity3D(const CriteriaOptions& o) : low_(o.proximity_3d_low) {}
   std::string Name() const override { return "proximity_3d"; }
   cv::Mat Evaluate(const SelectionContext& context) const override;
 
@@ -128,7 +154,7 @@ struct SelectionOptions {
   /// Candidates whose map point lies within this distance of a point that
   /// could not be fixated are left out.
   double refused_radius_m = 0.03;
-  void Check() const;  ///< throws std::invalid_argument naming the field
+  void Check() const;  ///< throws rig::InputError naming the key (fovea/params.h)
 };
 
 /// What one choice looked like, for the records.
@@ -152,7 +178,6 @@ struct SelectionSummary {
 class FixationSelector {
  public:
   /// The paper's four criteria with their default settings.
-  static std::vector<std::shared_ptr<const FixationCriterion>> DefaultCriteria();
 
   FixationSelector(std::vector<std::shared_ptr<const FixationCriterion>> criteria,
                    const SelectionOptions& options);

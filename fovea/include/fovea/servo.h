@@ -35,7 +35,7 @@ struct ServoOptions {
   /// otherwise the right camera sees another surface (an occluder, a
   /// repeated texture's copy) and the servo has not converged. 0: no check.
   double mutual_tolerance_px = 4.0;
-  void Check() const;
+  void Check() const;  ///< throws rig::InputError naming the key (fovea/params.h)
 };
 
 /// Depths along the left optical axis, metres.
@@ -88,6 +88,8 @@ struct ServoResult {
 /// start, or, given `first_depths` (the start's depth is a guess), every
 /// position a point at those depths can take. Throws rig::RigError if the
 /// rig refuses a move.
+/// `options` must have passed Check(): the run checks them once, before
+/// its work (RunFovea, RunIdr, RunConfig::Check), never per call.
 ServoResult Servo(rig::Rig& rig, const rig::StageState& start, const ServoOptions& options,
                   const std::optional<DepthRange>& first_depths = std::nullopt);
 

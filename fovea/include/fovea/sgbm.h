@@ -13,6 +13,7 @@ struct SgbmOptions {
   int uniqueness_ratio = 5;
   int speckle_window = 50;
   int speckle_range = 2;
+  void Check() const;  ///< throws rig::InputError naming the key (fovea/params.h)
 };
 
 /// StereoSGBM plugged into the foveated stage: it runs on one level's

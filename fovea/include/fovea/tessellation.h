@@ -19,7 +19,7 @@ struct TessellationOptions {
   /// half of it.
   double horizontal_disparity_limit_px = 32;
   int max_levels = 4;  ///< level k samples every 2^k pixels
-  void Check() const;
+  void Check() const;  ///< throws rig::InputError naming the key (fovea/params.h)
 };
 
 struct Tessellation {
@@ -54,6 +54,8 @@ double AxisHorizontalDisparity(const rig::CameraView& left, const rig::CameraVie
 
 /// Builds the tessellation for a verged pair fixating p_W, using the map's
 /// depths in the left view for Z_max and the mask.
+/// `options` must have passed Check(): the run checks them once, before
+/// its work (RunFovea, RunIdr, RunConfig::Check), never per call.
 Tessellation Tessellate(const rig::CameraView& left, const rig::CameraView& right,
                         const Eigen::Vector3d& fixation_W, const PatchMap& map,
                         const TessellationOptions& options);

@@ -13,7 +13,7 @@ struct VergenceOptions {
   int max_iterations = 30;      ///< Newton steps per camera
   double tolerance_px = 0.01;   ///< the point must project this close to the principal point
   double min_distance_m = 0.2;  ///< nearer points are not fixable
-  void Check() const;
+  void Check() const;           ///< throws rig::InputError naming the key (fovea/params.h)
 };
 
 /// Stage state that fixates a point, or why it cannot be fixated.
@@ -30,6 +30,8 @@ struct VergenceSolution {
 /// limits, behind a camera, too near, or that no solution projects within
 /// the tolerance of the principal point (after quantization to steps) is
 /// reported as not fixable, never clamped.
+/// `options` must have passed Check(): the run checks them once, before
+/// its work (RunFovea, RunIdr, RunConfig::Check), never per call.
 VergenceSolution Verge(const rig::RigGeometry& geometry, const rig::RigLimits& limits,
                        const rig::CameraIntrinsics& left, const rig::CameraIntrinsics& right,
                        const rig::StageState& baselines, const Eigen::Vector3d& p_W,

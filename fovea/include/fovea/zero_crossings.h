@@ -18,7 +18,7 @@ struct ZeroCrossingOptions {
   /// textures put 90% of their crossings above 0.33 to 0.98. 0.6 keeps
   /// homogeneous regions free of crossings up to noise sigma 2.3.
   double min_slope = 0.6;
-  void Check() const;  ///< throws std::invalid_argument naming the field
+  void Check() const;  ///< throws rig::InputError naming the key (fovea/params.h)
 };
 
 /// One zero crossing between pixels (x, y) and (x + 1, y).
@@ -42,6 +42,8 @@ struct ZeroCrossingImage {
 };
 
 /// LoG-filters a CV_8UC1 image and extracts its horizontal zero crossings.
+/// `options` must have passed Check(): the run checks them once, before
+/// its work (RunFovea, RunIdr, RunConfig::Check), never per call.
 ZeroCrossingImage ExtractZeroCrossings(const cv::Mat& gray, const ZeroCrossingOptions& options);
 
 /// For each crossing, the distance in pixels to the next crossing of the same

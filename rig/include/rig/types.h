@@ -67,7 +67,10 @@ struct CameraIntrinsics {
 /// world Z axis (positive turns the camera to its left, counter-clockwise seen
 /// from above) and tilt about the panned X axis (positive looks up).
 struct CameraStage {
-  double baseline_m = 0;
+  /// The carriage's position along the rail from its centre (the world
+  /// origin), metres: negative for the left carriage, positive for the right.
+  /// (The baseline is the difference of the two carriages' positions.)
+  double carriage_m = 0;
   double pan_rad = 0;
   double tilt_rad = 0;
 };
@@ -90,7 +93,7 @@ struct StageState {
   const CameraStage& operator[](Side side) const { return side == Side::kLeft ? left : right; }
   CameraStage& operator[](Side side) { return side == Side::kLeft ? left : right; }
   /// Distance between the two carriages along the rail.
-  double BaselineM() const { return right.baseline_m - left.baseline_m; }
+  double BaselineM() const { return right.carriage_m - left.carriage_m; }
   std::string ToString() const;
 };
 

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "rig/input_file.h"
+#include "rig/param.h"
 
 namespace sim {
 
@@ -18,13 +19,65 @@ class SceneError : public rig::InputError {
   using rig::InputError::InputError;
 };
 
+/// Every parameter of the simulated rig: its YAML key, meaning and range
+/// (see rig/param.h). SimRigConfig::Check() checks against these and the run
+/// configuration binds each to its field.
+namespace params {
+using rig::ParamSpec;
+inline constexpr ParamSpec kWidthPx{"rig.width_px", "image width, pixels", 64, 4096};
+inline constexpr ParamSpec kHeightPx{"rig.height_px", "image height, pixels", 48, 4096};
+inline constexpr ParamSpec kHorizontalFovDeg{
+    "rig.horizontal_fov_deg",
+    "lens: horizontal field of view edge to edge, degrees (16 mm lens: 30)", 5, 100};
+inline constexpr ParamSpec kOpticalCentreXM{"rig.optical_centre_x_m",
+                                            "each optical centre's offset from its pan/tilt axes' "
+                                            "intersection, head frame x (right), metres",
+                                            -0.15, 0.15};
+inline constexpr ParamSpec kOpticalCentreYM{
+    "rig.optical_centre_y_m", "the same, head frame y (forward), metres", -0.15, 0.15};
+inline constexpr ParamSpec kOpticalCentreZM{"rig.optical_centre_z_m",
+                                            "the same, head frame z (up), metres", -0.15, 0.15};
+inline constexpr ParamSpec kCarriageMinM{
+    "rig.carriage_min_m",
+    "baseline axes: each carriage's nearest approach to the rail centre, metres", 0, 0.05};
+inline constexpr ParamSpec kCarriageMaxM{
+    "rig.carriage_max_m", "baseline axes: each carriage's travel from the rail centre, metres",
+    0.01, 2};
+inline constexpr ParamSpec kHomeBaselineM{"rig.home_baseline_m",
+                                          "baseline at the home pose (the reference view's pose), "
+                                          "metres (within 2 x the carriages' travel)",
+                                          0.002, 4};
+inline constexpr ParamSpec kPanLimitDeg{"rig.pan_limit_deg",
+                                        "pan axes: symmetric travel limit, degrees", 1, 179};
+inline constexpr ParamSpec kTiltLimitDeg{"rig.tilt_limit_deg",
+                                         "tilt axes: symmetric travel limit, degrees", 1, 89};
+inline constexpr ParamSpec kBaselineStepsPerMm{"rig.baseline_steps_per_mm",
+                                               "baseline axes: motor steps per millimetre", 1, 1e6};
+inline constexpr ParamSpec kPanTiltStepsPerDeg{"rig.pan_tilt_steps_per_deg",
+                                               "pan and tilt axes: motor steps per degree", 1, 1e6};
+inline constexpr ParamSpec kSettleToleranceSteps{
+    "rig.settle_tolerance_steps",
+    "a move has settled when every axis is within this many steps of its command and slower than "
+    "that per 50 ms",
+    0.5, 100};
+inline constexpr ParamSpec kMoveTimeoutS{
+    "rig.move_timeout_s", "a move must settle within this, simulated seconds", 0.1, 600};
+inline constexpr ParamSpec kNoiseSigmaDn{"rig.noise_sigma_dn",
+                                         "sensor read noise, grey levels (0 = off)", 0, 50};
+inline constexpr ParamSpec kBlurSigmaPx{"rig.blur_sigma_px",
+                                        "optical blur before the noise, pixels (0 = off)", 0, 10};
+inline constexpr ParamSpec kRecordDir{
+    "rig.record_dir",
+    "sim: also write every capture to this folder (left_NNNNN.png, right_NNNNN.png) for replay"};
+}  // namespace params
+
 /// Sensor model applied to every captured image, in this order: Gaussian blur
 /// (optics), then additive Gaussian read noise, rounded and saturated to 8 bits.
 /// Off by default (tests); experiment configs turn it on.
 struct NoiseConfig {
   double read_noise_sigma_dn = 0;  ///< standard deviation in 8-bit grey levels
   double blur_sigma_px = 0;        ///< 0 disables the blur
-  void Check() const;              ///< throws SceneError on negative values
+  void Check() const;              ///< throws rig::InputError naming the key (params)
 };
 
 /// Everything that defines the simulated rig. Defaults follow the paper's
@@ -62,7 +115,7 @@ struct SimRigConfig {
   /// session through a HardwareRig's cameras).
   std::string record_dir;
 
-  /// Throws SceneError naming the first invalid field.
+  /// Throws rig::InputError naming the key of the first invalid field.
   void Check() const;
 };
 

@@ -18,8 +18,70 @@
 
 namespace experiments {
 
+/// The read noise of the experiments' cameras, grey levels: runs, IDR and
+/// fixation figures and the chessboards use it (the simulator's own default
+/// is 0, for the tests).
+constexpr double kExperimentNoiseSigmaDn = 2.0;
+
+/// The run-level parameters: the harness's own, beside the algorithms'
+/// (fovea/params.h) and the simulated rig's (sim::params).
+namespace params {
+using rig::ParamSpec;
+inline constexpr const char* kMethods[] = {"fovea", "static_sgbm", nullptr};
+inline constexpr const char* kMatchers[] = {"nl1", "sgbm", nullptr};
+inline constexpr const char* kRigTypes[] = {"sim", "hardware", nullptr};
+inline constexpr ParamSpec kScene{"scene",
+                                  "catalog scene name, random[:SEED[:N]], or path to an MJCF scene "
+                                  "file (empty: cylinder_planes)"};
+inline constexpr ParamSpec kSeed{"seed", "the one seed: sensor noise and every fixation draw", 0,
+                                 9007199254740992.0};
+inline constexpr ParamSpec kMethod{"method",
+                                   "fovea: the FOVEA loop; static_sgbm: the baseline, StereoSGBM "
+                                   "on the static pair at the home pose and widest "
+                                   "baseline",
+                                   0, 0, kMethods};
+inline constexpr ParamSpec kMatcher{"matcher", "matcher of the foveated stage", 0, 0, kMatchers};
+inline constexpr ParamSpec kRigType{
+    "rig.type", "sim: the simulated TAVT; hardware: serial stages and cameras (the keys below)", 0,
+    0, kRigTypes};
+inline constexpr ParamSpec kPort{"rig.port",
+                                 "hardware: the stages' serial port (e.g. /dev/ttyUSB0)"};
+inline constexpr ParamSpec kBaud{"rig.baud", "hardware: the serial port's baud rate", 1200, 230400};
+inline constexpr ParamSpec kEmulateStages{
+    "rig.emulate_stages",
+    "hardware: drive the indexer emulator (a pseudo-terminal in this process) instead of rig.port"};
+inline constexpr ParamSpec kUnits{"rig.units",
+                                  "hardware: indexer unit addresses of the six axes (left "
+                                  "baseline, pan, tilt, right baseline, pan, tilt)"};
+inline constexpr ParamSpec kDirections{
+    "rig.directions",
+    "hardware: motor direction of each axis against the rig's convention, +1 or -1, same order"};
+inline constexpr ParamSpec kLeftCamera{
+    "rig.left_camera",
+    "hardware: left camera: V4L2 index or path, video file, or image sequence (rec/left_%05d.png)"};
+inline constexpr ParamSpec kRightCamera{"rig.right_camera",
+                                        "hardware: right camera, as rig.left_camera"};
+inline constexpr ParamSpec kCalibration{
+    "rig.calibration", "hardware: calibration file (fovea calibrate, or OpenCV YAML by hand)"};
+inline constexpr ParamSpec kFrameTimeoutS{
+    "rig.frame_timeout_s", "hardware: longest wait for a camera frame, seconds", 0.01, 60};
+inline constexpr ParamSpec kBaselineVelocityMS{
+    "rig.baseline_velocity_m_s",
+    "hardware: baseline axes' speed, metres per second (acceleration 10x per second)", 1e-4, 1};
+inline constexpr ParamSpec kPanTiltVelocityRadS{
+    "rig.pan_tilt_velocity_rad_s",
+    "hardware: pan and tilt axes' speed, radians per second (acceleration 10x per second)", 1e-3,
+    10};
+inline constexpr ParamSpec kStaticBaselineM{
+    "static.baseline_m",
+    "static_sgbm's baseline, metres (0 = the widest at which a point at idr.z_min_m keeps within "
+    "half the image "
+    "width)",
+    0, 4};
+}  // namespace params
+
 struct RunConfig {
-  RunConfig() { rig.noise.read_noise_sigma_dn = 2.0; }
+  RunConfig() { rig.noise.read_noise_sigma_dn = kExperimentNoiseSigmaDn; }
   std::string scene;  ///< catalog name or path; empty = the default scene
   uint64_t seed = 0;  ///< the one seed: sensor noise and fixation draws
   /// "fovea": the FOVEA loop; "static_sgbm": the baseline it is compared
@@ -46,31 +108,20 @@ struct RunConfig {
   double static_baseline_m = 0;  ///< static_sgbm's baseline; 0 = the widest useful
   fovea::FoveaOptions fovea;
 
-  /// Checks what single ranges cannot (the parts against each other);
-  /// throws UsageError naming the key.
+  /// Checks every parameter against its spec and the parts against each
+  /// other; throws UsageError naming the key.
   void Check() const;
 };
 
 /// Six whole numbers from "a,b,c,d,e,f"; throws UsageError naming `key`.
 std::array<int, 6> SixInts(const std::string& text, const std::string& key);
 
-/// One parameter: a path in the YAML file ("idr.unique_share"), what it is,
-/// and where it lives in a RunConfig.
+/// One parameter of a RunConfig: its spec (key, meaning, range) and the field
+/// it sets. A parameter's default is the field's initial value.
 struct ConfigParam {
-  template <class T>
-  ConfigParam(std::string path_, std::string doc_, T* target_, double lo_ = 0, double hi_ = 0,
-              std::vector<std::string> choices_ = {})
-      : path(std::move(path_)),
-        doc(std::move(doc_)),
-        target(target_),
-        lo(lo_),
-        hi(hi_),
-        choices(std::move(choices_)) {}
-  std::string path;
-  std::string doc;
+  const rig::ParamSpec* spec;
   std::variant<double*, int*, bool*, std::string*, uint64_t*> target;
-  double lo = 0, hi = 0;             ///< inclusive range for numbers
-  std::vector<std::string> choices;  ///< allowed values for a string (empty = any)
+  const char* path() const { return spec->key; }
 };
 
 /// Every parameter of `config`, bound to its fields, in file order.

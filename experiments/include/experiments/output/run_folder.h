@@ -1,0 +1,73 @@
+// A run folder (`fovea run --out DIR`): its files, its records and summary,
+// and which of their keys are wall-clock times.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "experiments/config/config.h"
+#include "experiments/scoring/run_eval.h"
+#include "fovea/ddr.h"
+
+namespace experiments::run_folder {
+
+inline constexpr char kConfig[] = "config.yaml";       ///< the effective configuration
+inline constexpr char kSummary[] = "summary.json";     ///< the run's figures
+inline constexpr char kRecords[] = "fixations.jsonl";  ///< a record per attempt
+inline constexpr char kMapPly[] = "map.ply";           ///< the patch map as quads
+inline constexpr char kMapPicture[] = "map.png";       ///< static baseline: its map
+inline constexpr char kFixationPath[] = "fixation_path.png";
+inline constexpr char kReference[] = "reference.png";  ///< the reference view
+inline constexpr char kReport[] = "report.html";
+
+/// The fixations after which the map is pictured, as in the paper's
+/// figures (and the run's last one).
+inline constexpr std::array<int, 4> kSnapshotFixations = {1, 5, 15, 25};
+
+/// "map_after_05.png": the picture of the map after fixation `fixation`.
+std::string SnapshotName(int fixation);
+
+/// Whether a key of summary.json or of a record (or a flattened CSV column
+/// "time_s.select") is a wall-clock time: wall_time_s, compute_time_s and
+/// time_s. They are the only figures that differ between two runs of one
+/// configuration.
+bool IsWallClockKey(const std::string& key);
+
+/// One attempt's record (a line of fixations.jsonl).
+nlohmann::json RecordJson(const fovea::FixationRecord& record, const MapScore& score);
+
+/// What every summary.json holds, FOVEA's and the static baseline's: the
+/// score, the scene, seed and method, the patches by level and the times.
+nlohmann::json SummaryJson(const MapScore& score, const std::string& scene_path,
+                           const RunConfig& config, const std::array<int, 3>& patches_by_level,
+                           double motion_time_s, double compute_time_s, double wall_time_s);
+
+/// The fixation observer of a run: scores the map after every attempt,
+/// keeps the records, the fixation path, and the map's pictures after the
+/// snapshot fixations, and prints a progress line.
+class Recorder {
+ public:
+  Recorder(const std::string& dir, const std::string& scene_path, const ReferenceView& ref,
+           const sim::GroundTruth& truth, const RunConfig& config);
+  void operator()(const fovea::FixationRecord& record, const fovea::PatchMap& map);
+  const std::string& records() const { return jsonl_; }
+  const std::vector<Eigen::Vector3d>& path() const { return path_; }
+  const std::vector<Eigen::Vector3d>& refused() const { return refused_; }
+  double scoring_s = 0, output_s = 0;  ///< wall clock spent scoring and writing
+
+ private:
+  std::string dir_, scene_name_;
+  const ReferenceView& ref_;
+  const sim::GroundTruth& truth_;
+  double baseline_m_;
+  int fixations_;
+  std::vector<int> snapshots_;
+  Eigen::Vector3d view_target_ = Eigen::Vector3d::Zero();
+  std::string jsonl_;
+  std::vector<Eigen::Vector3d> path_, refused_;
+};
+
+}  // namespace experiments::run_folder

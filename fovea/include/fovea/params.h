@@ -1,0 +1,247 @@
+// Every parameter of the algorithms' options: its YAML key, meaning and
+// range, written once (rig::ParamSpec). The options' Check() checks against
+// these specs and the run configuration binds each to its field, so a key,
+// its range and its message are the same everywhere. Defaults are the
+// options structs' member initializers. Keys are grouped by the YAML
+// section the user sees: "idr." (IdrOptions), "foveal." (FixationOptions:
+// vergence, servo, tessellation, foveal stereo), "nl1." and "sgbm." (the
+// per-level matchers), "selection.", "criteria.", "integration." and
+// "loop." (FoveaOptions).
+#pragma once
+
+#include "rig/input_file.h"
+#include "rig/param.h"
+
+namespace fovea::params {
+
+using rig::ParamSpec;
+
+// ---- IDR: ZeroCrossingOptions, ZcMatchOptions, IdrOptions (paper II) ------
+inline constexpr ParamSpec kIdrLogSigmaPx{"idr.log_sigma_px",
+                                          "LoG scale of the zero crossings, pixels", 1, 8};
+inline constexpr ParamSpec kIdrLogMinSlope{
+    "idr.log_min_slope",
+    "a crossing counts only where the normalized LoG changes by at least this much across it, grey "
+    "levels "
+    "(0.6 keeps image noise of sigma up to 2.3 free of crossings)",
+    0, 10};
+inline constexpr ParamSpec kIdrOrientationToleranceRad{
+    "idr.orientation_tolerance_rad",
+    "matched crossings' orientations differ by at most this, radians", 0.01, 3.1416};
+inline constexpr ParamSpec kIdrTakeNearest{
+    "idr.take_nearest",
+    "resolve an ambiguous crossing by its smallest disparity instead of rejecting it (classic "
+    "matchers; false: "
+    "FOVEA's rule)"};
+inline constexpr ParamSpec kIdrUniqueShare{
+    "idr.unique_share", "share of zero crossings kept unambiguous at the initial baseline", 0.5, 1};
+inline constexpr ParamSpec kIdrZMinM{"idr.z_min_m", "nearest scene distance, metres", 0.05, 10};
+inline constexpr ParamSpec kIdrMaxSlantDeg{
+    "idr.max_slant_deg", "largest surface slant for the expansion factor, degrees", 0, 89};
+inline constexpr ParamSpec kIdrMaxExpansion{
+    "idr.max_expansion", "cap on the baseline expansion factor per stage", 1.1, 16};
+inline constexpr ParamSpec kIdrMinExpansion{
+    "idr.min_expansion",
+    "an expansion factor below this does not earn another stage (at most idr.max_expansion)", 1.01,
+    16};
+inline constexpr ParamSpec kIdrVergentSearchPx{
+    "idr.vergent_search_px", "P: the vergent stage resolves +-P px (IDR termination)", 0.5, 64};
+inline constexpr ParamSpec kIdrVergentBaselineM{
+    "idr.vergent_baseline_m",
+    "vergent baseline the IDR termination rule assumes, metres (not tied to foveal.baseline_m: at "
+    "0.06 m IDR "
+    "stops at a 0.012 m baseline and the coarser map costs coverage)",
+    0.001, 0.6};
+inline constexpr ParamSpec kIdrMaxStages{"idr.max_stages", "baseline stage budget", 1, 20};
+inline constexpr ParamSpec kIdrPatchSizePx{"idr.patch_size_px", "IDR patch size, pixels", 4, 128};
+inline constexpr ParamSpec kIdrDiscontinuityJumpPx{
+    "idr.discontinuity_jump_px",
+    "matches with a neighbour within 2 LoG sigma whose disparity differs by more than this lie at "
+    "a depth "
+    "discontinuity and stay out of the patches, pixels",
+    0.1, 64};
+inline constexpr ParamSpec kIdrInitialBaselineM{
+    "idr.initial_baseline_m",
+    "fixed initial baseline instead of the period rule, metres (0 = the rule)", 0, 0.6};
+inline constexpr ParamSpec kIdrFitMinSupport{
+    "idr.fit_min_support", "IDR patch fit: inlier measurements needed in a block", 3, 4096};
+inline constexpr ParamSpec kIdrFitTolerancePx{
+    "idr.fit_tolerance_px",
+    "IDR patch fit: measurements farther from the plane are outliers, pixels", 0.01, 16};
+inline constexpr ParamSpec kIdrFitMinInlierShare{
+    "idr.fit_min_inlier_share",
+    "IDR patch fit: a block needs this share of its measurements as inliers", 0, 1};
+inline constexpr ParamSpec kIdrFitRequireQuadrants{
+    "idr.fit_require_quadrants", "IDR patch fit: a block needs measurements in all four quadrants"};
+
+// ---- Vergence, servo, tessellation, foveal stereo: FixationOptions (III) --
+inline constexpr ParamSpec kFovealBaselineM{"foveal.baseline_m", "vergent baseline, metres", 0.001,
+                                            0.6};
+inline constexpr ParamSpec kFovealChoosePlacement{
+    "foveal.choose_placement",
+    "beyond the paper: place the carriages per fixation (symmetric, right or left carriage "
+    "innermost) so that no "
+    "mapped surface hides the point from either camera (false: symmetric about the rail centre)"};
+inline constexpr ParamSpec kFovealLeftPair{"foveal.left_pair",
+                                           "beyond the paper, with foveal.choose_placement: where "
+                                           "the map hides a point from every right camera, pair "
+                                           "the left camera with itself at two carriage positions "
+                                           "(the home pose's and foveal.baseline_m to its left; "
+                                           "motion stereo, the scene must hold still)"};
+inline constexpr ParamSpec kFovealVergenceMaxIterations{
+    "foveal.vergence_max_iterations", "vergence: Newton steps per camera", 1, 200};
+inline constexpr ParamSpec kFovealVergenceTolerancePx{
+    "foveal.vergence_tolerance_px",
+    "vergence: the point must project this close to the principal point, else it is not fixable, "
+    "pixels",
+    1e-4, 1};
+inline constexpr ParamSpec kFovealVergenceMinDistanceM{
+    "foveal.vergence_min_distance_m", "vergence: nearer points are not fixable, metres", 0, 1};
+inline constexpr ParamSpec kFovealServoWindowHalfPx{
+    "foveal.servo_window_half_px", "servoing's window is (2 h + 1) pixels square; h, pixels", 2,
+    100};
+inline constexpr ParamSpec kFovealServoSearchPx{
+    "foveal.servo_search_px", "servoing's first search on a mapped point: +- this many pixels", 1,
+    300};
+inline constexpr ParamSpec kFovealServoRefinePx{
+    "foveal.servo_refine_px",
+    "servoing after a move that nulled d: searches +- the larger of this and |d| / 4, pixels", 1,
+    300};
+inline constexpr ParamSpec kFovealServoTolerancePx{
+    "foveal.servo_tolerance_px", "servoing stops below this centre disparity, pixels", 0.01, 10};
+inline constexpr ParamSpec kFovealServoMaxSteps{"foveal.servo_max_steps", "servoing step budget", 1,
+                                                50};
+inline constexpr ParamSpec kFovealServoUniqueRatio{
+    "foveal.servo_unique_ratio",
+    "servoing on a hole searches every depth and keeps its best match only if its cost is below "
+    "this share of "
+    "the best elsewhere (1 = any)",
+    0.01, 1};
+inline constexpr ParamSpec kFovealServoMutualPx{
+    "foveal.servo_mutual_px",
+    "beyond the paper: a converged servo's match must be mutual (the right centre window, searched "
+    "back along the "
+    "left image's row, lands within this many pixels of the left centre), else the point is "
+    "refused (0 = no "
+    "check)",
+    0, 100};
+inline constexpr ParamSpec kFovealHorizontalDisparityLimitPx{
+    "foveal.horizontal_disparity_limit_px",
+    "the fovea's horizontal disparity limit (sets Z_T), pixels", 2, 256};
+inline constexpr ParamSpec kFovealMaxLevels{"foveal.max_levels",
+                                            "resolution levels of the tessellation", 1, 6};
+inline constexpr ParamSpec kFovealFoveaPatchPx{"foveal.fovea_patch_px",
+                                               "patch size at full resolution, pixels", 4, 64};
+inline constexpr ParamSpec kFovealPeripheryPatchPx{
+    "foveal.periphery_patch_px",
+    "patch size at coarser levels, full-resolution pixels (at least 4 pixels of the level)", 4, 64};
+inline constexpr ParamSpec kFovealMapMarginPx{
+    "foveal.map_margin_px",
+    "matching searches +- this many level pixels around the map's prediction", 0.1, 32};
+inline constexpr ParamSpec kFovealCoarseMarginPx{
+    "foveal.coarse_margin_px", "and +- this many level pixels around the coarser level's estimate",
+    0.1, 32};
+inline constexpr ParamSpec kFovealSilentConfidence{
+    "foveal.silent_confidence",
+    "see foveal.silent_check: the wider search's match confidence needed to drop a band match", 0,
+    1};
+inline constexpr ParamSpec kFovealFitMinSupport{
+    "foveal.fit_min_support",
+    "foveal and peripheral patch fit: inlier measurements needed in a block", 3, 4096};
+inline constexpr ParamSpec kFovealFitTolerancePx{
+    "foveal.fit_tolerance_px",
+    "foveal and peripheral patch fit: measurements farther from the plane are outliers, level "
+    "pixels",
+    0.01, 16};
+inline constexpr ParamSpec kFovealFitMinInlierShare{
+    "foveal.fit_min_inlier_share",
+    "foveal and peripheral patch fit: a block needs this share of its measurements as inliers", 0,
+    1};
+inline constexpr ParamSpec kFovealFitRequireQuadrants{
+    "foveal.fit_require_quadrants",
+    "foveal and peripheral patch fit: a block needs measurements in all four quadrants"};
+
+// ---- The per-level matchers -------------------------------------------------
+inline constexpr ParamSpec kNl1WindowHalfPx{
+    "nl1.window_half_px", "the NL1 matcher's window is (2 h + 1) pixels square; h, pixels", 1, 20};
+inline constexpr ParamSpec kNl1MinTextureDn{
+    "nl1.min_texture_dn", "NL1: a left window needs this mean absolute deviation, grey levels", 0,
+    50};
+inline constexpr ParamSpec kNl1LrTolerancePx{"nl1.lr_tolerance_px",
+                                             "NL1: left-right check tolerance, pixels", 0.01, 10};
+inline constexpr ParamSpec kSgbmBlockSize{"sgbm.block_size",
+                                          "StereoSGBM matcher: block size, pixels (odd)", 1, 21};
+inline constexpr ParamSpec kSgbmUniquenessRatio{"sgbm.uniqueness_ratio",
+                                                "StereoSGBM matcher: uniqueness ratio, %", 0, 100};
+inline constexpr ParamSpec kSgbmSpeckleWindow{
+    "sgbm.speckle_window", "StereoSGBM matcher: speckle filter window, pixels (0 = off)", 0, 1000};
+inline constexpr ParamSpec kSgbmSpeckleRange{
+    "sgbm.speckle_range", "StereoSGBM matcher: speckle filter disparity range", 0, 64};
+
+// ---- DDR: selection, criteria, integration, the loop (paper IV) -----------
+inline constexpr ParamSpec kSelectionDeterministic{
+    "selection.deterministic", "always fixate the composite's maximum instead of drawing"};
+inline constexpr ParamSpec kSelectionDrawScale{"selection.draw_scale",
+                                               "scale s of the exponential draw", 0.001, 100};
+inline constexpr ParamSpec kSelectionHistogramBins{"selection.histogram_bins",
+                                                   "bins of the composite's histogram", 2, 4096};
+inline constexpr ParamSpec kSelectionBorderPx{
+    "selection.border_px", "fixation candidates keep this far from the image edge, pixels", 0, 200};
+inline constexpr ParamSpec kSelectionRefusedRadiusM{
+    "selection.refused_radius_m",
+    "candidates this close to a point that could not be fixated are left out, metres", 0, 1};
+inline constexpr ParamSpec kCriteriaGradient{"criteria.gradient", "use gradient attraction"};
+inline constexpr ParamSpec kCriteriaSuppression{"criteria.suppression", "use local suppression"};
+inline constexpr ParamSpec kCriteriaProximity2d{"criteria.proximity_2d", "use 2D proximity"};
+inline constexpr ParamSpec kCriteriaProximity3d{"criteria.proximity_3d", "use 3D proximity"};
+inline constexpr ParamSpec kCriteriaGradientBlurPx{
+    "criteria.gradient_blur_px", "gradient attraction's smoothing scale, pixels", 0.1, 50};
+inline constexpr ParamSpec kCriteriaSuppressedWeight{
+    "criteria.suppressed_weight",
+    "local suppression's weight where the map is foveal (1 elsewhere)", 0, 1};
+inline constexpr ParamSpec kCriteriaSuppressionRadiusM{
+    "criteria.suppression_radius_m",
+    "local suppression also covers this distance around earlier fixation points, metres", 0, 1};
+inline constexpr ParamSpec kCriteriaPeripheralWeight{
+    "criteria.peripheral_weight",
+    "local suppression's weight where the map is peripheral (1 = the paper's rule: foveal data "
+    "only)",
+    0, 1};
+inline constexpr ParamSpec kCriteriaRevisitRadiusM{
+    "criteria.revisit_radius_m",
+    "local suppression's weight is 0 this close to an earlier fixation point (or a point aimed at "
+    "where the servo "
+    "settled farther than this from it), metres",
+    0, 1};
+inline constexpr ParamSpec kCriteriaProximity2dScalePx{
+    "criteria.proximity_2d_scale_px", "2D proximity's scale s in exp(-r / s), pixels", 1, 1e9};
+inline constexpr ParamSpec kCriteriaProximity3dLow{
+    "criteria.proximity_3d_low", "3D proximity's weight outside the Z_T band (1 inside)", 0, 1};
+inline constexpr ParamSpec kIntegrationOverlapShare{
+    "integration.overlap_share",
+    "overlap share at which new patches replace old ones (and finer data blocks new ones)", 0.01,
+    1};
+inline constexpr ParamSpec kLoopFixations{"loop.fixations", "successful fixations to make", 1,
+                                          10000};
+inline constexpr ParamSpec kLoopStayInIdrView{
+    "loop.stay_in_idr_view", "fixate only points inside the IDR view (the region the run maps)"};
+inline constexpr ParamSpec kLoopFixateHoles{"loop.fixate_holes",
+                                            "beyond the paper: pixels the map is silent at are "
+                                            "candidates, at the depth of the nearest mapped pixel "
+                                            "(false: the paper's rule)"};
+inline constexpr ParamSpec kLoopStallFixations{"loop.stall_fixations",
+                                               "stop when the foveal share grew by less than "
+                                               "stall_growth over this many fixations (0 = never)",
+                                               0, 10000};
+inline constexpr ParamSpec kLoopStallGrowth{"loop.stall_growth",
+                                            "see stall_fixations (share of the IDR view)", 0, 1};
+inline constexpr ParamSpec kLoopAttemptsPerFixation{
+    "loop.attempts_per_fixation",
+    "attempt budget per fixation wanted (points that cannot be fixated)", 1, 100};
+inline constexpr ParamSpec kFovealSilentCheck{
+    "foveal.silent_check",
+    "beyond the paper: where the map is silent, also search every depth from idr.z_min_m to "
+    "infinity and drop the "
+    "Z_T matches it confidently contradicts (false: the paper's rule, Z_T only)"};
+
+}  // namespace fovea::params
