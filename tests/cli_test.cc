@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "temp_scene.h"
@@ -273,4 +274,36 @@ TEST_CASE("a sweep over catalog, generated and numbered random scenes runs", "[c
   for (std::string line; std::getline(csv, line);) rows += !line.empty();
   CHECK(rows == 2);
   fs::remove_all(dir);
+}
+
+TEST_CASE("fovea fixate fixates a point the way fovea run does", "[cli][slow]") {
+  // Noise off: the run's reference view draws from the noise generator before
+  // IDR, fixate's does not; without noise both see the same images.
+  const fs::path run = TempDir("same_run"), fix = TempDir("same_fix");
+  Result r = Fovea("run --scene two_planes --fixations 1 --set rig.noise_sigma_dn=0 --out " +
+                   run.string());
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  std::ifstream records(run / "fixations.jsonl");
+  std::string line;
+  std::getline(records, line);
+  const nlohmann::json first = nlohmann::json::parse(line);
+  REQUIRE(first["ok"] == true);
+  char point[200];
+  std::snprintf(point, sizeof point, "%.17g %.17g %.17g", first["target_W"][0].get<double>(),
+                first["target_W"][1].get<double>(), first["target_W"][2].get<double>());
+  r = Fovea(std::string("fixate --scene two_planes --noise 0 --point ") + point + " --out " +
+            fix.string());
+  REQUIRE(r.exit_code == 0);
+  std::ifstream in(fix / "fixate.json");
+  const nlohmann::json fixate = nlohmann::json::parse(in);
+  for (int i = 0; i < 3; ++i)
+    CHECK(fixate["fixation_W"][i].get<double>() == first["fixation_W"][i].get<double>());
+  CHECK(fixate["servo"]["iterations"] == first["servo"]["iterations"]);
+  CHECK(fixate["servo"]["residual_px"].get<double>() ==
+        first["servo"]["residual_px"].get<double>());
+  CHECK(fixate["tessellation"]["z_t_far_m"].get<double>() ==
+        first["tessellation"]["z_t_far_m"].get<double>());
+  fs::remove_all(run);
+  fs::remove_all(fix);
 }
