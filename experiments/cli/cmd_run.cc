@@ -58,6 +58,16 @@ RunConfig EffectiveConfig(const RunArgs& args) {
 
 // The static StereoSGBM baseline, scored like a FOVEA run: summary.json with
 // the same keys, map.ply, map.png, reference.png, an empty fixations.jsonl.
+// The static baseline's options from the run's: its baseline, the scene's
+// nearest depth and the fovea's patch size.
+StaticSgbmOptions StaticOptionsOf(const RunConfig& config) {
+  StaticSgbmOptions options;
+  options.baseline_m = config.static_baseline_m;
+  options.min_depth_m = config.fovea.idr.z_min_m;
+  options.block_px = config.fovea.fixation.foveal.fovea_patch_px;
+  return options;
+}
+
 int RunStatic(const RunConfig& config, OutputFolder& folder, Clock::time_point t_wall) {
   namespace rf = run_folder;
   auto sim = LoadSceneOf(config);
@@ -65,11 +75,7 @@ int RunStatic(const RunConfig& config, OutputFolder& folder, Clock::time_point t
   const std::string dir = folder.path();
   WriteTextAtomic(dir + "/" + rf::kConfig, DumpConfig(config));
   const ReferenceView ref = MakeReferenceView(rig, sim->truth());
-  StaticSgbmOptions options;
-  options.baseline_m = config.static_baseline_m;
-  options.min_depth_m = config.fovea.idr.z_min_m;
-  options.block_px = config.fovea.fixation.foveal.fovea_patch_px;
-  const StaticSgbmResult r = RunStaticSgbm(rig, options);
+  const StaticSgbmResult r = RunStaticSgbm(rig, StaticOptionsOf(config));
   const MapScore score = ScoreMap(r.map, ref, sim->truth(), r.baseline_m, /*per_patch=*/true);
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   for (const fovea::Patch& p : r.map.patches()) centre += p.Centre() / double(r.map.size());
@@ -91,6 +97,20 @@ int RunStatic(const RunConfig& config, OutputFolder& folder, Clock::time_point t
   std::fprintf(stderr, "fovea run: static StereoSGBM, baseline %.3f m: %s -> %s\n", r.baseline_m,
                ScoreLine(score).c_str(), folder.target().c_str());
   return 0;
+}
+
+// FOVEA's map against the static StereoSGBM baseline's on the pixels both
+// map (summary: vs_static). Run after the fixations: the static pair's moves
+// and captures change nothing the run did.
+nlohmann::json VsStatic(rig::Rig& rig, const RunConfig& config, const fovea::PatchMap& map,
+                        const ReferenceView& ref) {
+  const StaticSgbmResult sgbm = RunStaticSgbm(rig, StaticOptionsOf(config));
+  const CommonPixels common = CompareOnCommonPixels(map, sgbm.map, ref);
+  auto figure = [&](double v) { return common.pixels ? nlohmann::json(v) : nlohmann::json(); };
+  return {{"pixels", common.pixels},
+          {"fovea_median_abs_error_m", figure(common.median_abs_error_m)},
+          {"static_median_abs_error_m", figure(common.other_median_abs_error_m)},
+          {"static_baseline_m", sgbm.baseline_m}};
 }
 
 // Wall-clock seconds by stage over every attempt of a run.
@@ -166,6 +186,8 @@ int Run(const RunArgs& args) {
   t = Clock::now();
   const MapScore score =
       ScoreMap(run.map, ref, sim->truth(), config.fovea.fixation.baseline_m, /*per_patch=*/true);
+  const nlohmann::json vs_static =
+      config.compare_static ? VsStatic(rig, config, run.map, ref) : nlohmann::json();
   recorder.scoring_s += Since(t);
   t = Clock::now();
   WriteTextAtomic(dir + "/" + rf::kRecords, recorder.records());
@@ -175,10 +197,10 @@ int Run(const RunArgs& args) {
   WriteImageAtomic(dir + "/" + rf::kReference, ref.view.gray);
   recorder.output_s += Since(t);
   const double wall = Since(t_wall);
-  WriteTextAtomic(
-      dir + "/" + rf::kSummary,
-      FoveaSummary(run, score, sim->scene_path(), config, recorder, reference_s, wall).dump(2) +
-          "\n");
+  nlohmann::json summary =
+      FoveaSummary(run, score, sim->scene_path(), config, recorder, reference_s, wall);
+  if (!vs_static.is_null()) summary["vs_static"] = vs_static;
+  WriteTextAtomic(dir + "/" + rf::kSummary, summary.dump(2) + "\n");
   folder.Commit();
   const fovea::StageTimes sum = SumTimes(run.records);
   std::fprintf(stderr, "fovea run: %d fixations (%s): %s -> %s\n", run.fixations_done,

@@ -297,6 +297,7 @@ void AddDdrParams(RunConfig* c, std::vector<ConfigParam>* params) {
                      {&fp::kCriteriaProximity2dScalePx, &f.criteria.proximity_2d_scale_px},
                      {&fp::kCriteriaProximity3dLow, &f.criteria.proximity_3d_low},
                      {&ep::kStaticBaselineM, &c->static_baseline_m},
+                     {&ep::kScoreCompareStatic, &c->compare_static},
                      {&fp::kIntegrationOverlapShare, &f.integration.overlap_share},
                  });
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <opencv2/imgproc.hpp>
 
 #include "fovea/geometry.h"
 #include "fovea/stats.h"
@@ -12,10 +13,12 @@ using fovea::Quantile;
 namespace {
 
 struct Accumulator {
+  long bad = 0;
   std::vector<double> abs, rel, steps;
   double sum_sq = 0, sum_abs = 0;
   long within = 0;
   void Add(double z, double zt, double step) {
+    if (!(std::abs(z - zt) <= kBadShare * zt)) ++bad;
     const double e = std::abs(z - zt);
     abs.push_back(e);
     rel.push_back(e / zt);
@@ -27,6 +30,7 @@ struct Accumulator {
   ErrorFigures Figures(long total) const {
     ErrorFigures f;
     f.pixels = static_cast<long>(abs.size());
+    f.bad = bad;
     f.share = total ? double(f.pixels) / total : 0;
     if (abs.empty()) return f;
     f.median_abs_error_m = Quantile(abs, 0.5);
@@ -57,6 +61,33 @@ bool RightCameraSees(const rig::RigGeometry& geometry, const std::vector<double>
   return false;
 }
 
+// Pixels within kEdgeRadiusPx of a jump of more than kEdgeJumpM in the true
+// depth (nothing counts as infinitely far).
+cv::Mat NearEdge(const cv::Mat& depth_m) {
+  cv::Mat edge = cv::Mat::zeros(depth_m.size(), CV_8U);
+  auto z = [&](int y, int x) {
+    const float d = depth_m.at<float>(y, x);
+    return d > 0 ? double(d) : 1e9;
+  };
+  for (int y = 0; y < depth_m.rows; ++y)
+    for (int x = 0; x < depth_m.cols; ++x) {
+      const double here = z(y, x);
+      if ((x + 1 < depth_m.cols && std::abs(here - z(y, x + 1)) > kEdgeJumpM) ||
+          (y + 1 < depth_m.rows && std::abs(here - z(y + 1, x)) > kEdgeJumpM)) {
+        edge.at<uchar>(y, x) = 255;
+        if (x + 1 < depth_m.cols && std::abs(here - z(y, x + 1)) > kEdgeJumpM)
+          edge.at<uchar>(y, x + 1) = 255;
+        if (y + 1 < depth_m.rows && std::abs(here - z(y + 1, x)) > kEdgeJumpM)
+          edge.at<uchar>(y + 1, x) = 255;
+      }
+    }
+  cv::Mat near;
+  cv::dilate(
+      edge, near,
+      cv::getStructuringElement(cv::MORPH_RECT, {2 * kEdgeRadiusPx + 1, 2 * kEdgeRadiusPx + 1}));
+  return near;
+}
+
 }  // namespace
 
 ReferenceView MakeReferenceView(rig::Rig& rig, const sim::GroundTruth& truth) {
@@ -66,6 +97,7 @@ ReferenceView MakeReferenceView(rig::Rig& rig, const sim::GroundTruth& truth) {
   ref.depth_m = truth.RayCastDepth(ref.view.world_T_camera, ref.view.intrinsics, &ref.geom_ids);
   ref.textured = truth.TexturedMask(ref.geom_ids);
   ref.textured_pixels = cv::countNonZero(ref.textured);
+  ref.near_edge = NearEdge(ref.depth_m);
 
   const rig::AxisLimit& travel = rig.Limits()[rig::Axis::kRightBaseline];
   std::vector<double> carriages;
@@ -125,8 +157,9 @@ MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref,
   cv::Mat depth, ids;
   map.Render(ref.view.world_T_camera, ref.view.intrinsics, &depth, &ids);
   const double f = ref.view.intrinsics.fx_px;
-  Accumulator all;
+  Accumulator all, edges;
   std::array<Accumulator, 3> level;
+  std::array<Accumulator, 6> resolution;
   struct PerSurface {
     long pixels = 0, mapped = 0, foveal = 0, stereo_visible = 0;
     Accumulator errors;
@@ -151,7 +184,10 @@ MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref,
       if (lv == static_cast<int>(fovea::PatchLevel::kFoveal)) ++foveal, ++ps.foveal;
       const double step = zt * zt / (f * baseline_m);
       all.Add(z, zt, step);
+      if (ref.near_edge.at<uchar>(y, x)) edges.Add(z, zt, step);
       level[lv].Add(z, zt, step);
+      if (map[id].level != fovea::PatchLevel::kIdr)
+        resolution[std::clamp(map[id].resolution_level, 0, 5)].Add(z, zt, step);
       ps.errors.Add(z, zt, step);
     }
   const long total = ref.textured_pixels;
@@ -161,7 +197,10 @@ MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref,
   s.stereo_visible_coverage =
       ref.stereo_visible_pixels ? double(mapped_stereo_visible) / ref.stereo_visible_pixels : 0;
   s.overall = all.Figures(total);
+  s.good_coverage = total ? double(s.overall.pixels - s.overall.bad) / total : 0;
+  s.near_edges = edges.Figures(total);
   for (int i = 0; i < 3; ++i) s.by_level[i] = level[i].Figures(total);
+  for (int i = 0; i < 6; ++i) s.by_resolution[i] = resolution[i].Figures(total);
   for (const auto& [geom, ps] : surfaces) {
     SurfaceFigures sf;
     sf.name = truth.GeomName(geom);
@@ -202,8 +241,14 @@ nlohmann::json Figure(long pixels, double value) {
   return pixels > 0 ? nlohmann::json(value) : nlohmann::json();
 }
 
+// Share of a figure's pixels that are bad: null over no pixel.
+nlohmann::json BadShare(const ErrorFigures& f) {
+  return Figure(f.pixels, f.pixels ? double(f.bad) / f.pixels : 0);
+}
+
 nlohmann::json ErrorJson(const ErrorFigures& f) {
   return {{"pixels", f.pixels},
+          {"bad_share", BadShare(f)},
           {"share", f.share},
           {"median_abs_error_m", Figure(f.pixels, f.median_abs_error_m)},
           {"mean_abs_error_m", Figure(f.pixels, f.mean_abs_error_m)},
@@ -227,6 +272,13 @@ nlohmann::json ScoreJson(const MapScore& s) {
   j["mean_abs_error_m"] = Figure(n, s.overall.mean_abs_error_m);
   j["within_1pct"] = Figure(n, s.overall.within_1pct);
   j["median_error_steps"] = Figure(n, s.overall.median_error_steps);
+  for (int i = 0; i < 6; ++i)
+    if (s.by_resolution[i].pixels > 0)
+      j["by_resolution"][std::to_string(i)] = ErrorJson(s.by_resolution[i]);
+  j["good_coverage"] = s.good_coverage;
+  j["bad_share"] = BadShare(s.overall);
+  j["edge_bad_share"] = BadShare(s.near_edges);
+  j["edge_pixels"] = s.near_edges.pixels;
   for (int i = 0; i < 3; ++i)
     j["by_level"][fovea::PatchLevelName(static_cast<fovea::PatchLevel>(i))] =
         ErrorJson(s.by_level[i]);
@@ -244,6 +296,24 @@ nlohmann::json ScoreJson(const MapScore& s) {
                            {"median_m", Figure(s.patches_scored, s.patch_error_median_m)},
                            {"p90_m", Figure(s.patches_scored, s.patch_error_p90_m)}};
   return j;
+}
+
+CommonPixels CompareOnCommonPixels(const fovea::PatchMap& map, const fovea::PatchMap& other,
+                                   const ReferenceView& ref) {
+  cv::Mat a, b;
+  map.Render(ref.view.world_T_camera, ref.view.intrinsics, &a, nullptr);
+  other.Render(ref.view.world_T_camera, ref.view.intrinsics, &b, nullptr);
+  std::vector<double> ea, eb;
+  for (int y = 0; y < a.rows; ++y)
+    for (int x = 0; x < a.cols; ++x) {
+      const double zt = ref.depth_m.at<float>(y, x);
+      if (!ref.textured.at<uchar>(y, x) || zt <= 0 || a.at<float>(y, x) <= 0 ||
+          b.at<float>(y, x) <= 0)
+        continue;
+      ea.push_back(std::abs(a.at<float>(y, x) - zt));
+      eb.push_back(std::abs(b.at<float>(y, x) - zt));
+    }
+  return {static_cast<long>(ea.size()), Quantile(ea, 0.5), Quantile(eb, 0.5)};
 }
 
 std::string ScoreLine(const MapScore& s, bool brief) {

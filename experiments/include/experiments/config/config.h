@@ -72,6 +72,11 @@ inline constexpr ParamSpec kPanTiltVelocityRadS{
     "rig.pan_tilt_velocity_rad_s",
     "hardware: pan and tilt axes' speed, radians per second (acceleration 10x per second)", 1e-3,
     10};
+inline constexpr ParamSpec kScoreCompareStatic{
+    "score.compare_static",
+    "a FOVEA run also maps the scene with the static StereoSGBM baseline (after its fixations) and "
+    "compares the "
+    "two on the pixels both map (summary: vs_static)"};
 inline constexpr ParamSpec kStaticBaselineM{
     "static.baseline_m",
     "static_sgbm's baseline, metres (0 = the widest at which a point at idr.z_min_m keeps within "
@@ -106,6 +111,7 @@ struct RunConfig {
     double pan_tilt_velocity_rad_s = 1.0;
   } hardware;
   double static_baseline_m = 0;  ///< static_sgbm's baseline; 0 = the widest useful
+  bool compare_static = true;    ///< a FOVEA run compares itself with the static baseline
   fovea::FoveaOptions fovea;
 
   /// Checks every parameter against its spec and the parts against each

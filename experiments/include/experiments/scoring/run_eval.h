@@ -29,7 +29,20 @@ struct ReferenceView {
   /// itself (rig::LeftCameraPair) sees there.
   cv::Mat stereo_visible;
   long stereo_visible_pixels = 0;
+  /// CV_8U, 255 within kEdgeRadiusPx of a true depth discontinuity of more
+  /// than kEdgeJumpM (or of a surface's silhouette against nothing).
+  cv::Mat near_edge;
 };
+
+/// A depth discontinuity is a jump of more than this between neighbouring
+/// pixels of the true depth, metres; pixels within kEdgeRadiusPx of one are
+/// near an edge (edge_bad_share).
+constexpr double kEdgeJumpM = 0.02;
+constexpr int kEdgeRadiusPx = 8;
+
+/// A mapped pixel is bad when its depth is off by more than this share of the
+/// true depth (and good when within it).
+constexpr double kBadShare = 0.01;
 
 /// Right carriage positions, evenly spread over its travel, tried by
 /// ReferenceView::stereo_visible.
@@ -40,6 +53,7 @@ ReferenceView MakeReferenceView(rig::Rig& rig, const sim::GroundTruth& truth);
 
 struct ErrorFigures {
   long pixels = 0;   ///< mapped textured pixels scored
+  long bad = 0;      ///< of them, off by more than kBadShare of depth
   double share = 0;  ///< of the visible textured pixels
   double median_abs_error_m = 0, mean_abs_error_m = 0, rmse_m = 0;
   double median_rel_error = 0;    ///< |Z - Z_true| / Z_true
@@ -64,7 +78,15 @@ struct MapScore {
       0;  ///< of the visible textured pixels, those in ReferenceView::stereo_visible
   double stereo_visible_coverage = 0;  ///< share of those with an estimate
   ErrorFigures overall;
+  /// Share of the visible textured pixels mapped within kBadShare of their
+  /// depth: coverage x within_1pct, what the map gets right.
+  double good_coverage = 0;
+  /// The mapped pixels within kEdgeRadiusPx of a depth discontinuity.
+  ErrorFigures near_edges;
   std::array<ErrorFigures, 3> by_level;  ///< by PatchLevel of the patch seen
+  /// Foveal and peripheral pixels by the resolution level of the patch seen
+  /// (0 = full resolution; level k samples every 2^k pixels).
+  std::array<ErrorFigures, 6> by_resolution;
   std::vector<SurfaceFigures> surfaces;
   /// Per-patch 3D distance from the patch centre to the true surface (along
   /// the patch normal, by ray casting), when asked for.
@@ -76,6 +98,15 @@ struct MapScore {
 /// Scores `map` in the reference view; `baseline_m` sets the disparity step.
 MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref,
                   const sim::GroundTruth& truth, double baseline_m, bool per_patch);
+
+/// Two maps on the pixels both map in the reference view (visible,
+/// textured): how many, and each one's median absolute depth error there.
+struct CommonPixels {
+  long pixels = 0;
+  double median_abs_error_m = 0, other_median_abs_error_m = 0;
+};
+CommonPixels CompareOnCommonPixels(const fovea::PatchMap& map, const fovea::PatchMap& other,
+                                   const ReferenceView& ref);
 
 /// The figures as summary.json holds them. Error figures over no pixel (an
 /// empty map, an unmapped level or surface) are null, not zero.
