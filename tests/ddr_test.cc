@@ -113,21 +113,28 @@ TEST_CASE(
     INFO(f);
     CHECK(fs::file_size(out / f) > 100);
   }
-  // Near plane at y = 0.6 m, far plane at 1.3 m.
+  // Near plane at y = 0.6 m, far plane at 1.3 m. The choice is a draw from
+  // the criteria's histogram, so the path varies with the seed and every
+  // setting (seed 0: NFFFNNNNNNFFFFFFFFFFFFNNN, seed 1:
+  // NNFFFFFFFFFFFFFFFFNNNNNNN): the nearest textured surface first, then
+  // both planes get fixations and both end mapped.
   std::vector<bool> near;
   for (const auto& r : records)
     if (r["ok"]) near.push_back(r["fixation_W"][1].get<double>() < 0.95);
   REQUIRE(near.size() == 25);
-  for (int i = 0; i < 5; ++i) CHECK(near[i]);              // stays on the near plane for a while
-  CHECK(std::count(near.begin(), near.end(), false) > 0);  // then moves to the far one
-  const auto first_far = std::find(near.begin(), near.end(), false) - near.begin();
-  CHECK(std::count(near.begin() + first_far, near.end(), true) <= 2);  // and mostly stays there
+  CHECK(near[0]);
+  CHECK(std::count(near.begin(), near.end(), true) >= 5);
+  CHECK(std::count(near.begin(), near.end(), false) >= 5);
+  for (const char* plane : {"near_plane", "far_plane"}) {
+    INFO(plane);
+    CHECK(records.back()["score"]["by_surface"][plane]["coverage"].get<double>() >= 0.95);
+  }
   // The map's foveal share grows with fixations; the whole map stays accurate.
   const double f1 = records.front()["score"]["foveal_coverage"],
                f25 = records.back()["score"]["foveal_coverage"];
   CHECK(f25 > f1);
   CHECK(s["median_rel_error"].get<double>() < 0.01);
-  CHECK(s["coverage"].get<double>() >= 0.95);  // measured 0.989
+  CHECK(s["coverage"].get<double>() >= 0.95);  // measured 0.994 (2 levels)
   fs::remove_all(out);
 }
 

@@ -55,6 +55,10 @@ TEST_CASE("where the map is silent, a surface outside Z_T gives no false patches
     fovea::FixationOptions o = fovea::ResolvedFixationOptions({});  // the run's
     o.baseline_m = 0.12;         // Z_T about -0.15 / +0.2 m around 1.2 m: the blocks far outside it
     o.choose_placement = false;  // carriages symmetric, as measured
+    // The paper's four levels, as measured: the false matches come from the
+    // band search of levels 1-3 around the fovea. With the default two
+    // levels neither setting gives the fovea a patch off by over 5%.
+    o.foveal.tessellation.max_levels = 4;
     o.foveal.silent_near_m = silent_near_m;
     const fovea::Nl1Matcher matcher;
     const Eigen::Vector3d plywood(-0.25, 1.2, 0.1);
@@ -75,6 +79,6 @@ TEST_CASE("where the map is silent, a surface outside Z_T gives no false patches
                                                << ", wider check " << ours.first << " of "
                                                << ours.second);
   CHECK(paper.first >= 5);
-  CHECK(ours.first * 2 <= paper.first);              // measured 4 against 14
+  CHECK(ours.first * 2 <= paper.first);              // measured 4 against 10
   CHECK(ours.second >= paper.second - paper.first);  // the right patches stay
 }

@@ -2,6 +2,8 @@
 #include "fovea/integration.h"
 
 #include <catch2/catch.hpp>
+#include <cmath>
+#include <random>
 
 #include "test_views.h"
 
@@ -44,8 +46,9 @@ TEST_CASE("foveal patches replace the coarser patches they cover, and only those
 TEST_CASE("peripheral data never replaces foveal data", "[fovea][integration]") {
   const rig::CameraView view = View();
   fovea::PatchMap map = Grid(8, 0.1, 1.0, fovea::PatchLevel::kFoveal);
-  // Peripheral patches: one 20 cm patch over the fovea, others around it.
-  fovea::PatchMap periphery = Grid(5, 0.5, 1.0, fovea::PatchLevel::kPeripheral, 2);
+  // Peripheral patches, all inside the view: one 14 cm patch over the fovea,
+  // others around it.
+  fovea::PatchMap periphery = Grid(5, 0.35, 1.0, fovea::PatchLevel::kPeripheral, 2);
   const auto stats = fovea::Integrate(&map, periphery, view);
   CHECK(stats.dropped_under_finer == 1);  // the one over the fovea
   CHECK(stats.added == 24);
@@ -53,12 +56,12 @@ TEST_CASE("peripheral data never replaces foveal data", "[fovea][integration]") 
   CHECK(map.CountByLevel() == std::array<int, 3>{0, 24, 64});
   // Peripheral replaces peripheral of the same or coarser resolution...
   const auto again =
-      fovea::Integrate(&map, Grid(5, 0.5, 1.0, fovea::PatchLevel::kPeripheral, 1), view);
+      fovea::Integrate(&map, Grid(5, 0.35, 1.0, fovea::PatchLevel::kPeripheral, 1), view);
   CHECK(again.replaced[1] == 24);
   CHECK(map.CountByLevel() == std::array<int, 3>{0, 24, 64});
   // ...but a coarser resolution does not replace a finer one.
   const auto coarser =
-      fovea::Integrate(&map, Grid(5, 0.5, 1.0, fovea::PatchLevel::kPeripheral, 3), view);
+      fovea::Integrate(&map, Grid(5, 0.35, 1.0, fovea::PatchLevel::kPeripheral, 3), view);
   CHECK(coarser.added == 0);
   CHECK(coarser.dropped_under_finer == 25);
 }
@@ -77,4 +80,166 @@ TEST_CASE("integration options are checked", "[fovea][integration]") {
   fovea::IntegrationOptions o;
   o.overlap_share = 0;
   CHECK_THROWS_WITH(o.Check(), Catch::Contains("overlap_share"));
+}
+
+namespace {
+
+// A grid of patches at depth y + an offset drawn per patch from N(0, sigma),
+// each patch knowing its sigma.
+fovea::PatchMap NoisyGrid(int n, double h, double y, double sigma, std::mt19937_64* rng) {
+  fovea::PatchMap grid = Grid(n, h, y, fovea::PatchLevel::kFoveal);
+  std::normal_distribution<double> noise(0, sigma);
+  fovea::PatchMap out;
+  for (fovea::Patch p : grid.patches()) {
+    const double e = noise(*rng);
+    for (auto& c : p.corners_W) c.y() += e;
+    p.sigma_z_m = sigma;
+    out.Add(p);
+  }
+  return out;
+}
+
+// RMS depth error of the map against a plane at depth y, over the pixels it
+// covers within `half_px` of the image centre (away from the grids' rims,
+// where a patch's footprint depends on its depth).
+double RmsError(const fovea::PatchMap& map, const rig::CameraView& view, double y, int half_px) {
+  cv::Mat depth;
+  map.Render(view.world_T_camera, view.intrinsics, &depth, nullptr);
+  const int r0 = depth.rows / 2, c0 = depth.cols / 2;
+  double sum = 0;
+  long n = 0;
+  for (int r = r0 - half_px; r < r0 + half_px; ++r)
+    for (int c = c0 - half_px; c < c0 + half_px; ++c)
+      if (const float z = depth.at<float>(r, c); z > 0) {
+        sum += (z - y) * (z - y);
+        ++n;
+      }
+  return n ? std::sqrt(sum / n) : 0;
+}
+
+}  // namespace
+
+TEST_CASE("fusing two noisy observations of a plane divides the error by sqrt 2",
+          "[fovea][integration]") {
+  // Two independent observations of the plane y = 1, each patch off by
+  // N(0, 5 mm): the inverse-variance mean of two is off by 5 / sqrt 2 mm.
+  const rig::CameraView view = View();
+  const double sigma = 0.005;
+  std::mt19937_64 rng(3);
+  double before = 0, after = 0;
+  const int trials = 10;
+  for (int t = 0; t < trials; ++t) {
+    fovea::PatchMap map = NoisyGrid(12, 0.3, 1.0, sigma, &rng);
+    const fovea::PatchMap second = NoisyGrid(12, 0.3, 1.0, sigma, &rng);
+    before += RmsError(map, view, 1.0, 60) / trials;
+    const auto stats = fovea::Integrate(&map, second, view);
+    // Two observations more than 3 sigma apart (0.3% of pairs) read as two
+    // surfaces and are not fused.
+    CHECK(stats.fused >= 140);
+    CHECK(stats.added == 144);
+    // The fused patches replace the old ones, but for a few on the grid's
+    // rim whose new footprint is smaller (farther) than the old one.
+    CHECK(stats.replaced[2] >= 130);
+    after += RmsError(map, view, 1.0, 60) / trials;
+    // Every fused patch is more certain than either observation; those with
+    // all four corners fused (all but some on the rim, whose corners' rays
+    // may miss the old grid) are certain by exactly sqrt 2.
+    int surer = 0, halved = 0;
+    for (const fovea::Patch& p : map.patches()) {
+      surer += p.sigma_z_m < sigma - 1e-12;
+      halved += std::abs(p.sigma_z_m - sigma / std::sqrt(2.0)) < 1e-9;
+    }
+    CHECK(surer == stats.fused);
+    CHECK(halved >= 100);
+  }
+  INFO("RMS error before " << 1e3 * before << " mm, after " << 1e3 * after << " mm");
+  CHECK(before == Approx(sigma).epsilon(0.15));
+  CHECK(after / before == Approx(1 / std::sqrt(2.0)).epsilon(0.1));
+  // Without fusion the new observation replaces the old one: no gain.
+  fovea::PatchMap map = NoisyGrid(12, 0.3, 1.0, sigma, &rng);
+  fovea::IntegrationOptions paper;
+  paper.fuse = false;
+  CHECK(fovea::Integrate(&map, NoisyGrid(12, 0.3, 1.0, sigma, &rng), view, paper).fused == 0);
+}
+
+TEST_CASE("a coarse patch that certain data contradicts goes, whichever came first",
+          "[fovea][integration]") {
+  const rig::CameraView view = View();
+  // A peripheral patch 20 cm in front of a surface foveal data sees at 1 m:
+  // the camera that saw the surface saw through it.
+  fovea::PatchMap map = Grid(1, 0.1, 0.8, fovea::PatchLevel::kPeripheral, 1);
+  fovea::Patch coarse = map[0];
+  coarse.sigma_z_m = 0.01;
+  map = fovea::PatchMap();
+  map.Add(coarse);
+  fovea::PatchMap fine;
+  const fovea::PatchMap grid = Grid(4, 0.1, 1.0, fovea::PatchLevel::kFoveal);
+  for (fovea::Patch p : grid.patches()) {
+    p.sigma_z_m = 0.001;
+    fine.Add(p);
+  }
+  const auto stats = fovea::Integrate(&map, fine, view);
+  CHECK(stats.removed_contradicted[1] == 1);
+  CHECK(stats.added == 16);
+  CHECK(map.CountByLevel() == std::array<int, 3>{0, 0, 16});
+  // The other way round: the coarse patch arrives after the fine data and is
+  // dropped.
+  const auto late = fovea::Integrate(
+      &map,
+      [&] {
+        fovea::PatchMap m;
+        m.Add(coarse);
+        return m;
+      }(),
+      view);
+  CHECK(late.dropped_contradicted == 1);
+  CHECK(map.CountByLevel() == std::array<int, 3>{0, 0, 16});
+  // With contradictions off (the paper's rule) the coarse patch stays.
+  fovea::IntegrationOptions paper;
+  paper.contradiction_share = 1;
+  CHECK(fovea::Integrate(
+            &map,
+            [&] {
+              fovea::PatchMap m;
+              m.Add(coarse);
+              return m;
+            }(),
+            view, paper)
+            .added == 1);
+}
+
+TEST_CASE("a patch mostly outside the view is not replaced by what covers its sliver in it",
+          "[fovea][integration]") {
+  const rig::CameraView view = View();  // sees x in [-0.53, 0.53] m at 1 m
+  // An IDR patch from x = 0.4 to 0.8 m: a third of it inside the view.
+  fovea::PatchMap map;
+  fovea::Patch idr;
+  idr.corners_W = {Eigen::Vector3d(0.4, 1.0, -0.1), Eigen::Vector3d(0.8, 1.0, -0.1),
+                   Eigen::Vector3d(0.8, 1.0, 0.1), Eigen::Vector3d(0.4, 1.0, 0.1)};
+  idr.level = fovea::PatchLevel::kIdr;
+  map.Add(idr);
+  // Foveal patches over x in [0.3, 0.7]: all of the sliver the view shows.
+  fovea::PatchMap fine;
+  for (int i = 0; i < 4; ++i) {
+    fovea::Patch p = idr;
+    p.level = fovea::PatchLevel::kFoveal;
+    const double x0 = 0.3 + 0.1 * i;
+    p.corners_W = {Eigen::Vector3d(x0, 1.0, -0.1), Eigen::Vector3d(x0 + 0.1, 1.0, -0.1),
+                   Eigen::Vector3d(x0 + 0.1, 1.0, 0.1), Eigen::Vector3d(x0, 1.0, 0.1)};
+    fine.Add(p);
+  }
+  const auto stats = fovea::Integrate(&map, fine, view);
+  CHECK(stats.replaced[0] == 0);
+  CHECK(map.CountByLevel() == std::array<int, 3>{1, 0, 4});
+  // Moved into the view, the same patch is replaced by the same cover.
+  fovea::PatchMap inside;
+  fovea::Patch idr_in = idr;
+  for (auto& c : idr_in.corners_W) c.x() -= 0.3;  // x from 0.1 to 0.5
+  inside.Add(idr_in);
+  fovea::PatchMap cover;
+  for (fovea::Patch p : fine.patches()) {
+    for (auto& c : p.corners_W) c.x() -= 0.2;  // x from 0.1 to 0.5
+    cover.Add(p);
+  }
+  CHECK(fovea::Integrate(&inside, cover, view).replaced[0] == 1);
 }

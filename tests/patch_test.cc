@@ -2,6 +2,8 @@
 
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <limits>
+#include <random>
 
 namespace {
 std::vector<fovea::DisparitySample> PlaneSamples(double a, double b, double c, double x0, double y0,
@@ -103,4 +105,40 @@ TEST_CASE("patch map: rendering into a view gives depth and patch ids", "[fovea]
       CHECK(depth.at<float>(v, x) ==
             Approx(hit->distance_m / k.Ray({double(x), double(v)}).norm()).epsilon(1e-5));
     }
+}
+
+TEST_CASE("blocks across a depth step split instead of bridging it", "[fovea][patch]") {
+  // A 64 x 64 disparity image: 10 px left of x = 37, 20 px right of it
+  // (noise 0.1 px), except a 4 px strip left of the step where matching
+  // found nothing (the nearer surface's fattening, dropped).
+  cv::Mat d(64, 64, CV_32F);
+  std::mt19937_64 rng(5);
+  std::normal_distribution<float> noise(0, 0.1f);
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x)
+      d.at<float>(y, x) = x >= 33 && x < 37 ? std::numeric_limits<float>::quiet_NaN()
+                                            : (x < 37 ? 10.f : 20.f) + noise(rng);
+  fovea::PlaneFitOptions options;
+  options.min_inlier_share = 0.8;
+  const auto whole = fovea::FitBlocks(d, 16, options, /*min_fill_share=*/0, 16, nullptr);
+  const auto split = fovea::FitBlocks(d, 16, options, /*min_fill_share=*/0.5, 4, nullptr);
+  // A plane may reach over the step by no more than the fit tolerance: at
+  // every pixel of its block, the true disparity lies within it of the plane.
+  auto worst = [&](const std::vector<fovea::BlockFit>& fits) {
+    double w = 0;
+    for (const fovea::BlockFit& b : fits)
+      for (int y = b.y; y < b.y + b.size; ++y)
+        for (int x = b.x; x < b.x + b.size; ++x)
+          if (x < 33 || x >= 37) w = std::max(w, std::abs((x < 37 ? 10.0 : 20.0) - b.fit(x, y)));
+    return w;
+  };
+  INFO("whole blocks: worst " << worst(whole) << " px over " << whole.size()
+                              << " blocks; split: worst " << worst(split) << " px over "
+                              << split.size() << " blocks");
+  CHECK(worst(whole) > 5);  // the paper's whole blocks: one reaches over the step
+  CHECK(worst(split) <= options.fit_tolerance_px);
+  // Away from the step the blocks stay whole.
+  int whole_blocks = 0;
+  for (const fovea::BlockFit& b : split) whole_blocks += b.size == 16;
+  CHECK(whole_blocks == 12);  // 4 rows x (2 left + 1 right) blocks clear of x = 32..47
 }

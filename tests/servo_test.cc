@@ -7,8 +7,10 @@
 #include <string>
 
 #include "experiments/config/config.h"
+#include "fovea/ddr.h"
 #include "fovea/foveal.h"
 #include "fovea/geometry.h"
+#include "fovea/idr.h"
 #include "fovea/vergence.h"
 #include "scenes/catalog.h"
 
@@ -171,4 +173,40 @@ TEST_CASE(
     CHECK(std::abs(*r.servo.mutual_mismatch_px) < 0.5);
     CHECK((r.fixation_W - open).norm() < 0.02);
   }
+}
+
+TEST_CASE(
+    "a servo settled on a false match in empty air is refused when the map knows the surface "
+    "behind",
+    "[fovea][servo][slow]") {
+  // The staircase: nothing nearer than its first riser at 0.62 m. Aimed
+  // 0.4 of the way from the left camera to a point on the wall, the servo
+  // settles near 0.45 m, in air, on a match that both the search and its
+  // mutual check accept (the textures repeat 4 times a face); the IDR
+  // map holds the steps behind that point, certain to a few millimetres.
+  auto sim = NoisyScene("staircase");
+  rig::Rig& rig = sim->rig();
+  const fovea::Nl1Matcher matcher;
+  const fovea::IdrResult idr = fovea::RunIdr(rig, {});
+  REQUIRE(idr.map.size() > 100);
+  fovea::FixationOptions o = fovea::ResolvedFixationOptions({});  // the run's
+  o.choose_placement = false;  // the symmetric carriages OnLeftAxis assumes
+  const Eigen::Vector3d air = OnLeftAxis(rig, {-0.1, 1.0, 0.0}, 0.4, o.baseline_m);
+  o.map_check = false;
+  const fovea::FixationResult trusting = fovea::Fixate(rig, idr.map, air, matcher, o);
+  INFO("without the check: ok " << trusting.ok << ", " << trusting.why << ", fixated at "
+                                << trusting.fixation_W.transpose());
+  REQUIRE(trusting.ok);
+  CHECK(trusting.fixation_W.y() < 0.55);  // a false fixation, in front of every step
+  o.map_check = true;
+  const fovea::FixationResult checked = fovea::Fixate(rig, idr.map, air, matcher, o);
+  INFO(checked.why);
+  CHECK_FALSE(checked.ok);
+  CHECK(checked.why.find("in front of the surface the map holds") != std::string::npos);
+  CHECK(checked.foveal.patches.size() == 0);
+  // A point on a riser itself passes.
+  const fovea::FixationResult step = fovea::Fixate(rig, idr.map, {-0.1, 0.805, 0.005}, matcher, o);
+  INFO(step.why);
+  CHECK(step.ok);
+  CHECK((step.fixation_W - Eigen::Vector3d(-0.1, 0.805, 0.005)).norm() < 0.02);
 }

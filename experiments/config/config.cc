@@ -196,6 +196,7 @@ void AddLoopParams(RunConfig* c, std::vector<ConfigParam>* params) {
                                     {&fp::kLoopFixations, &f.fixations},
                                     {&fp::kLoopStayInIdrView, &f.stay_in_idr_view},
                                     {&fp::kLoopFixateHoles, &f.fixate_holes},
+                                    {&fp::kLoopPrescreenHoles, &f.prescreen_holes},
                                     {&fp::kLoopStallFixations, &f.stall_fixations},
                                     {&fp::kLoopStallGrowth, &f.stall_growth},
                                     {&fp::kLoopAttemptsPerFixation, &f.attempts_per_fixation},
@@ -240,6 +241,7 @@ void AddFovealParams(RunConfig* c, std::vector<ConfigParam>* params) {
                      {&fp::kFovealBaselineM, &x.baseline_m},
                      {&fp::kFovealChoosePlacement, &x.choose_placement},
                      {&fp::kFovealLeftPair, &x.left_pair},
+                     {&fp::kFovealMapCheck, &x.map_check},
                      {&fp::kFovealVergenceMaxIterations, &x.vergence.max_iterations},
                      {&fp::kFovealVergenceTolerancePx, &x.vergence.tolerance_px},
                      {&fp::kFovealVergenceMinDistanceM, &x.vergence.min_distance_m},
@@ -250,6 +252,10 @@ void AddFovealParams(RunConfig* c, std::vector<ConfigParam>* params) {
                      {&fp::kFovealPeripheryPatchPx, &x.foveal.periphery_patch_px},
                      {&fp::kFovealMapMarginPx, &x.foveal.map_margin_px},
                      {&fp::kFovealCoarseMarginPx, &x.foveal.coarse_margin_px},
+                     {&fp::kFovealEdgeErosionPx, &x.foveal.edge_erosion_px},
+                     {&fp::kFovealEdgeJumpPx, &x.foveal.edge_jump_px},
+                     {&fp::kFovealMinFillShare, &x.foveal.min_fill_share},
+                     {&fp::kFovealMinBlockPx, &x.foveal.min_block_px},
                      {&fp::kFovealFitMinSupport, &x.foveal.plane_fit.min_support},
                      {&fp::kFovealFitTolerancePx, &x.foveal.plane_fit.fit_tolerance_px},
                      {&fp::kFovealFitMinInlierShare, &x.foveal.plane_fit.min_inlier_share},
@@ -299,6 +305,8 @@ void AddDdrParams(RunConfig* c, std::vector<ConfigParam>* params) {
                      {&ep::kStaticBaselineM, &c->static_baseline_m},
                      {&ep::kScoreCompareStatic, &c->compare_static},
                      {&fp::kIntegrationOverlapShare, &f.integration.overlap_share},
+                     {&fp::kIntegrationContradictionShare, &f.integration.contradiction_share},
+                     {&fp::kIntegrationFuse, &f.integration.fuse},
                  });
 }
 

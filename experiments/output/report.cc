@@ -223,6 +223,8 @@ std::vector<SweepRow> SweepRows(const std::string& dir, const nlohmann::json& gr
 const std::vector<std::pair<std::string, std::string>>& SweepFigures() {
   static const std::vector<std::pair<std::string, std::string>> kFigures = {
       {"coverage", "coverage"},
+      {"good_coverage", "good coverage"},
+      {"edge_bad_share", "bad share near edges"},
       {"foveal_coverage", "foveal coverage"},
       {"median_abs_error_m", "median |depth error|, m"},
       {"median_rel_error", "median relative error"},
@@ -325,6 +327,69 @@ std::string RunsTable(const nlohmann::json& grid, const std::vector<SweepRow>& r
   return h + "</table>";
 }
 
+// The trust figures per scene: each variant's mean over its runs (seeds and
+// any other axes), FOVEA and the static pair side by side, and the
+// comparison on the pixels both map.
+std::string SceneTable(const std::vector<SweepRow>& rows) {
+  static const std::vector<std::pair<std::string, std::string>> kColumns = {
+      {"coverage", "coverage"},
+      {"good_coverage", "good coverage (within 1%)"},
+      {"bad_share", "bad share"},
+      {"edge_bad_share", "bad share near edges"},
+      {"median_abs_error_m", "median |error|, mm"},
+      {"median_rel_error", "median rel. error, %"},
+      {"rmse_m", "RMSE, mm"},
+      {"patch_3d_error.p90_m", "patch 3D error p90, mm"},
+      {"stale_idr_patches", "stale IDR patches"},
+      {"refused_share", "refused share of attempts"},
+      {"vs_static.fovea_median_abs_error_m", "common pixels: FOVEA median, mm"},
+      {"vs_static.static_median_abs_error_m", "common pixels: static median, mm"}};
+  auto value = [](const nlohmann::json& s, const std::string& key) {
+    if (key == "refused_share") return Num(s, "refused") / std::max(1.0, Num(s, "attempts"));
+    const double v = Num(s, key);
+    const bool metres = key.size() > 2 && key.compare(key.size() - 2, 2, "_m") == 0;
+    return key == "median_rel_error" ? 100 * v : metres ? 1000 * v : v;
+  };
+  std::map<std::string, std::map<std::string, std::vector<const SweepRow*>>> by_scene;
+  std::vector<std::string> scenes;
+  for (const SweepRow& r : rows) {
+    if (!by_scene.count(r.scene)) scenes.push_back(r.scene);
+    by_scene[r.scene][r.variant].push_back(&r);
+  }
+  std::string h =
+      "<h2>By scene</h2><p>Each variant's mean over its runs. Good coverage: the share of the "
+      "reference view's visible textured pixels mapped within 1% of their true depth; bad share: "
+      "of the mapped pixels, those off by more; near edges: within 8 px of a true depth jump of "
+      "more than 2 cm. The last two columns compare the FOVEA map with the static pair's on the "
+      "pixels both map.</p><table><tr><th class=l>scene</th><th class=l>variant</th><th>runs</th>";
+  for (const auto& [key, label] : kColumns) h += "<th>" + Html(label) + "</th>";
+  h += "</tr>\n";
+  int wins = 0, compared = 0;
+  for (const std::string& scene : scenes)
+    for (const auto& [variant, runs] : by_scene[scene]) {
+      h += "<tr><td class=l>" + Html(fs::path(scene).stem().string()) + "</td><td class=l>" +
+           Html(variant) + "</td><td>" + std::to_string(runs.size()) + "</td>";
+      std::map<std::string, double> mean;
+      for (const auto& [key, label] : kColumns) {
+        double sum = 0;
+        int n = 0;
+        for (const SweepRow* r : runs)
+          if (const double v = value(r->summary, key); std::isfinite(v)) sum += v, ++n;
+        mean[key] = n ? sum / n : std::nan("");
+        h += "<td>" + (n ? Fmt(mean[key]) : std::string("-")) + "</td>";
+      }
+      h += "</tr>\n";
+      const double f = mean["vs_static.fovea_median_abs_error_m"],
+                   st = mean["vs_static.static_median_abs_error_m"];
+      if (std::isfinite(f) && std::isfinite(st)) ++compared, wins += f <= st;
+    }
+  h += "</table>";
+  if (compared)
+    h += "<p>FOVEA's median error is at most the static pair's on the pixels both map on " +
+         std::to_string(wins) + " of " + std::to_string(compared) + " scene rows.</p>";
+  return h + "\n";
+}
+
 std::string SweepReport(const std::string& dir) {
   const nlohmann::json grid = ReadJson(dir + "/grid.json");
   int missing = 0;
@@ -350,7 +415,7 @@ std::string SweepReport(const std::string& dir) {
        " (static_sgbm: StereoSGBM on the static parallel pair; deterministic: always the "
        "composite's "
        "maximum).</p>\n";
-  return h + AxisPlots(grid, rows) + RunsTable(grid, rows) + "</body></html>\n";
+  return h + SceneTable(rows) + AxisPlots(grid, rows) + RunsTable(grid, rows) + "</body></html>\n";
 }
 
 }  // namespace

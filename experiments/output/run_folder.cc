@@ -20,7 +20,8 @@ nlohmann::json SelectionJson(const fovea::SelectionSummary& s) {
                       {"composite_chosen", s.composite_chosen},
                       {"drawn_value", s.drawn_value},
                       {"bin", s.bin},
-                      {"in_hole", s.in_hole}};
+                      {"in_hole", s.in_hole},
+                      {"prescreened", s.prescreened}};
   for (const auto& [name, v] : s.criteria) j["criteria_vs_mean"][name] = v;
   return j;
 }
@@ -54,7 +55,12 @@ void AddFixation(const fovea::FixationRecord& r, nlohmann::json* j) {
                          {"dropped_under_finer", in.dropped_under_finer},
                          {"replaced_idr", in.replaced[0]},
                          {"replaced_peripheral", in.replaced[1]},
-                         {"replaced_foveal", in.replaced[2]}};
+                         {"replaced_foveal", in.replaced[2]},
+                         {"dropped_contradicted", in.dropped_contradicted},
+                         {"fused", in.fused},
+                         {"removed_contradicted_idr", in.removed_contradicted[0]},
+                         {"removed_contradicted_peripheral", in.removed_contradicted[1]},
+                         {"removed_contradicted_foveal", in.removed_contradicted[2]}};
 }
 
 }  // namespace

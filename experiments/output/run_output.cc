@@ -100,6 +100,29 @@ cv::Mat PatchDepthBesideTruth(const fovea::PatchMap& map, const rig::CameraView&
   return side;
 }
 
+// The map's depth against the truth, pixel by pixel: green within 1% of the
+// true depth, yellow within 5%, red beyond; dark grey where the truth has a
+// surface the map lacks; magenta where the map has depth and the truth none.
+cv::Mat ErrorPanel(const cv::Mat& map_depth, const cv::Mat& true_depth) {
+  cv::Mat img(map_depth.size(), CV_8UC3, cv::Scalar(0, 0, 0));
+  for (int v = 0; v < img.rows; ++v)
+    for (int u = 0; u < img.cols; ++u) {
+      const float z = map_depth.at<float>(v, u), t = true_depth.at<float>(v, u);
+      cv::Vec3b& px = img.at<cv::Vec3b>(v, u);
+      if (t <= 0) {
+        if (z > 0) px = {255, 0, 255};
+      } else if (z <= 0) {
+        px = {48, 48, 48};
+      } else {
+        const float rel = std::abs(z - t) / t;
+        px = rel <= 0.01f   ? cv::Vec3b(0, 170, 0)
+             : rel <= 0.05f ? cv::Vec3b(0, 220, 255)
+                            : cv::Vec3b(0, 0, 255);
+      }
+    }
+  return img;
+}
+
 cv::Mat MapSnapshot(const fovea::PatchMap& map, const ReferenceView& ref,
                     const Eigen::Vector3d& target_W, const std::string& caption) {
   const int w = ref.view.intrinsics.width_px, h = ref.view.intrinsics.height_px;
@@ -108,15 +131,17 @@ cv::Mat MapSnapshot(const fovea::PatchMap& map, const ReferenceView& ref,
   double lo = 0, hi = 0;
   cv::minMaxLoc(ref.depth_m, &lo, &hi, nullptr, nullptr, ref.depth_m > 0);
   cv::Mat row;
-  cv::hconcat(std::vector<cv::Mat>{ObliqueView(map, target_W, w, h), ColorizeDepth(depth, lo, hi),
-                                   ColorizeDepth(ref.depth_m, lo, hi)},
-              row);
+  cv::hconcat(
+      std::vector<cv::Mat>{ObliqueView(map, target_W, w, h), ColorizeDepth(depth, lo, hi),
+                           ColorizeDepth(ref.depth_m, lo, hi), ErrorPanel(depth, ref.depth_m)},
+      row);
   cv::Mat out(row.rows + 28, row.cols, CV_8UC3, cv::Scalar(255, 255, 255));
   row.copyTo(out(cv::Rect(0, 28, row.cols, row.rows)));
   cv::putText(out, caption, {8, 20}, cv::FONT_HERSHEY_SIMPLEX, 0.6, {0, 0, 0}, 1, cv::LINE_AA);
-  const char* labels[3] = {"patches, oblique view (grey IDR, blue peripheral, orange foveal)",
-                           "map depth, reference view", "true depth"};
-  for (int i = 0; i < 3; ++i)
+  const char* labels[4] = {"patches, oblique view (grey IDR, blue peripheral, orange foveal)",
+                           "map depth, reference view", "true depth",
+                           "error: green <1%, yellow <5%, red more, grey unmapped"};
+  for (int i = 0; i < 4; ++i)
     cv::putText(out, labels[i], {i * w + 8, 28 + h - 10}, cv::FONT_HERSHEY_SIMPLEX, 0.45,
                 {255, 255, 255}, 1, cv::LINE_AA);
   return out;

@@ -51,7 +51,11 @@ fovea::PatchMap DepthToPatches(const rig::CameraView& view, const cv::Mat& depth
         ok = d > 0;
         if (ok) p.corners_W[c] = view.world_T_camera * ((fb_px / d) * k.Ray({xs[c], ys[c]}));
       }
-      if (ok) map.Add(p);
+      if (!ok) continue;
+      const Eigen::Vector3d right_W = view.world_T_camera.translation() +
+                                      (fb_px / k.fx_px) * view.world_T_camera.linear().col(0);
+      fovea::SetDepthSigma(&p, view, right_W, std::max(fovea::kMatchSigmaPx, fit->rms_px));
+      map.Add(p);
     }
   return map;
 }

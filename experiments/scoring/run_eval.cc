@@ -151,6 +151,27 @@ ReferenceView MakeReferenceView(rig::Rig& rig, const sim::GroundTruth& truth) {
   return ref;
 }
 
+int StaleIdrPatches(const fovea::PatchMap& map, const rig::CameraView& view) {
+  fovea::PatchMap idr, finer;
+  for (const fovea::Patch& p : map.patches())
+    (p.level == fovea::PatchLevel::kIdr ? idr : finer).Add(p);
+  if (idr.size() == 0 || finer.size() == 0) return 0;
+  cv::Mat idr_ids, finer_ids;
+  idr.Render(view.world_T_camera, view.intrinsics, nullptr, &idr_ids);
+  finer.Render(view.world_T_camera, view.intrinsics, nullptr, &finer_ids);
+  std::vector<long> footprint(idr.size(), 0), covered(idr.size(), 0);
+  for (int y = 0; y < idr_ids.rows; ++y)
+    for (int x = 0; x < idr_ids.cols; ++x)
+      if (const int id = idr_ids.at<int>(y, x); id >= 0) {
+        ++footprint[id];
+        covered[id] += finer_ids.at<int>(y, x) >= 0;
+      }
+  int stale = 0;
+  for (size_t i = 0; i < idr.size(); ++i)
+    stale += footprint[i] > 0 && covered[i] >= kStaleCoveredShare * footprint[i];
+  return stale;
+}
+
 MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref,
                   const sim::GroundTruth& truth, double baseline_m, bool per_patch) {
   MapScore s;
@@ -231,6 +252,7 @@ MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref,
     s.patches_scored = static_cast<int>(err.size());
     s.patch_error_median_m = Quantile(err, 0.5);
     s.patch_error_p90_m = Quantile(err, 0.9);
+    s.stale_idr_patches = StaleIdrPatches(map, ref.view);
   }
   return s;
 }
@@ -291,10 +313,12 @@ nlohmann::json ScoreJson(const MapScore& s) {
                                 {"median_rel_error", Figure(sf.mapped, sf.median_rel_error)},
                                 {"median_error_steps", Figure(sf.mapped, sf.median_error_steps)},
                                 {"rmse_m", Figure(sf.mapped, sf.rmse_m)}};
-  if (s.has_patch_error)
+  if (s.has_patch_error) {
     j["patch_3d_error"] = {{"patches", s.patches_scored},
                            {"median_m", Figure(s.patches_scored, s.patch_error_median_m)},
                            {"p90_m", Figure(s.patches_scored, s.patch_error_p90_m)}};
+    j["stale_idr_patches"] = s.stale_idr_patches;
+  }
   return j;
 }
 

@@ -59,7 +59,7 @@ namespace {
 
 // What the loop carries from one attempt to the next.
 struct LoopState {
-  rig::CameraView view;  ///< the current view, from which the next target is chosen
+  rig::StereoFrame frame;  ///< the current pair, from whose left view the next target is chosen
   bool has_fixation = false;
   Tessellation current;  ///< the current fixation's
   std::vector<Eigen::Vector3d> refused;
@@ -68,8 +68,11 @@ struct LoopState {
 };
 
 // The next target: IDR's point first, then the selector's choice in the
-// current view.
-SelectionSummary ChooseTarget(const FoveaRun& run, const LoopState& state,
+// current view. With prescreen_holes, a hole whose window has no unique
+// match along its ray in the current pair is passed over without a move
+// (and its neighbourhood with it, as a refused point's), up to
+// kMaxPrescreened times.
+SelectionSummary ChooseTarget(const FoveaRun& run, LoopState& state,
                               const FixationSelector& selector, const FoveaOptions& options,
                               int attempt, std::mt19937_64* rng) {
   if (attempt == 1) {
@@ -78,15 +81,24 @@ SelectionSummary ChooseTarget(const FoveaRun& run, const LoopState& state,
     first.point_W = run.idr.first_fixation_W;
     return first;
   }
-  SelectionContext context =
-      SelectionContext::Make(state.view.gray, state.view, run.map, options.fixate_holes);
+  const rig::CameraView& view = state.frame.left;
+  SelectionContext context = SelectionContext::Make(view.gray, view, run.map, options.fixate_holes);
   context.has_fixation = state.has_fixation;
   context.fixation_depth_m = state.current.fixation_depth_m;
   context.z_t_near_m = state.current.z_t_near_m;
   context.z_t_far_m = state.current.z_t_far_m;
   context.visits = state.visits;
   if (options.stay_in_idr_view) context.region = run.idr.final_frame.left;
-  return selector.Choose(context, run.map, state.refused, rng);
+  constexpr int kMaxPrescreened = 8;
+  const DepthRange every_depth{options.idr.z_min_m, kFarDepthM};
+  for (int i = 0;; ++i) {
+    SelectionSummary s = selector.Choose(context, run.map, state.refused, rng);
+    s.prescreened = i;
+    if (!s.ok || !s.in_hole || !options.prescreen_holes || i == kMaxPrescreened ||
+        UniqueAlongRay(state.frame, s.pixel, every_depth, options.fixation.servo))
+      return s;
+    state.refused.push_back(s.point_W);
+  }
 }
 
 // The record's figures of a fixation that succeeded.
@@ -112,8 +124,8 @@ void Absorb(const FixationResult& r, const rig::CameraView& idr_view,
             const IntegrationOptions& integration, FoveaRun* run, LoopState* state,
             FixationRecord* rec) {
   const auto t = Clock::now();
-  state->view = r.servo.frame.left;
-  rec->integration = Integrate(&run->map, r.foveal.patches, state->view, integration);
+  state->frame = r.servo.frame;
+  rec->integration = Integrate(&run->map, r.foveal.patches, state->frame.left, integration);
   run->map.BuildIndex();
   rec->time.integrate_s = Since(t);
   rec->map_by_level = run->map.CountByLevel();
@@ -150,7 +162,7 @@ FoveaRun RunFovea(rig::Rig& rig, const StereoMatcher& matcher, const FoveaOption
   }
   const rig::CameraView& idr_view = run.idr.final_frame.left;
   LoopState state;
-  state.view = idr_view;
+  state.frame = run.idr.final_frame;
   auto record = [&](const FixationRecord& rec) {
     run.compute_time_s += rec.time.ComputeS();
     run.records.push_back(rec);

@@ -20,6 +20,10 @@ void FovealOptions::Check() const {
   rig::CheckParam(params::kFovealMapMarginPx, map_margin_px);
   rig::CheckParam(params::kFovealCoarseMarginPx, coarse_margin_px);
   rig::CheckParam(params::kFovealSilentConfidence, silent_confidence);
+  rig::CheckParam(params::kFovealEdgeErosionPx, edge_erosion_px);
+  rig::CheckParam(params::kFovealEdgeJumpPx, edge_jump_px);
+  rig::CheckParam(params::kFovealMinFillShare, min_fill_share);
+  rig::CheckParam(params::kFovealMinBlockPx, min_block_px);
   plane_fit.Check(params::kFovealFitMinSupport, params::kFovealFitTolerancePx,
                   params::kFovealFitMinInlierShare);
   // Set from idr.z_min_m (ResolvedFixationOptions), not a parameter of its own.
@@ -150,62 +154,85 @@ int DropOutsideBand(const Level& level, const StereoMatcher& matcher, SearchRang
   return dropped;
 }
 
-// Patches over the part of a level the finer one does not cover, each
-// spanning its whole block (blocks that tile the image leave no cracks), its
-// corners triangulated from both rays. Returns how many were added.
-int LevelPatches(const rig::StereoFrame& frame, const Tessellation& t, const Level& level,
-                 const cv::Mat& disparity, const FovealOptions& options, int fixation,
-                 PatchMap* patches) {
+// Window matching carries a nearer surface's disparity over a farther one's
+// pixels beside their edge (a window straddling the edge is dominated by the
+// nearer texture, in both directions of the left-right check): invalidates
+// the pixels within `radius` of a pixel whose disparity is more than
+// `jump_px` smaller. Returns how many.
+int ErodeAtDisparityJumps(int radius, double jump_px, cv::Mat* disparity) {
+  if (radius <= 0) return 0;
+  cv::Mat farthest = disparity->clone();
+  farthest.setTo(std::numeric_limits<float>::infinity(), farthest != farthest);  // NaN: no limit
+  cv::erode(farthest, farthest,
+            cv::getStructuringElement(cv::MORPH_RECT, {2 * radius + 1, 2 * radius + 1}));
+  int n = 0;
+  for (int y = 0; y < disparity->rows; ++y)
+    for (int x = 0; x < disparity->cols; ++x) {
+      float& d = disparity->at<float>(y, x);
+      if (std::isfinite(d) && d - farthest.at<float>(y, x) > jump_px) {
+        d = std::numeric_limits<float>::quiet_NaN();
+        ++n;
+      }
+    }
+  return n;
+}
+
+// The patch of one fitted block of a level: it spans its whole block
+// (blocks that tile the image leave no cracks), its corners triangulated
+// from both rays; nullopt if a corner's rays do not meet.
+std::optional<Patch> BlockPatch(const rig::StereoFrame& frame, const Level& level,
+                                const BlockFit& b, int fixation) {
   const rig::CameraView& left = frame.left;
   const rig::CameraView& right = frame.right;
   const double s = level.scale;
-  const cv::Rect inner = level.index > 0 ? t.rects[level.index - 1] : cv::Rect();
-  // Peripheral patches keep about the same size in the image at every level
-  // (the paper's were about twice the foveal ones), but never fewer than 4 x
-  // 4 of the level's pixels; their fit tolerance shrinks with the level so
-  // that it stays near a full-resolution pixel and a plane cannot bridge a
-  // depth step.
+  Patch p;
+  p.level = level.index == 0 ? PatchLevel::kFoveal : PatchLevel::kPeripheral;
+  p.resolution_level = level.index;
+  p.fixation = fixation;
+  p.fit_rms_px = b.fit.rms_px;
+  p.support = b.fit.support;
+  const double xs[4] = {b.x - 0.5, b.x + b.size - 0.5, b.x + b.size - 0.5, b.x - 0.5};
+  const double ys[4] = {b.y - 0.5, b.y - 0.5, b.y + b.size - 0.5, b.y + b.size - 0.5};
+  for (int c = 0; c < 4; ++c) {
+    const double d = b.fit(xs[c], ys[c]) * s;
+    const double u = (xs[c] + 0.5) * s - 0.5, v = (ys[c] + 0.5) * s - 0.5;
+    const auto tri =
+        TriangulateMidpoint(PixelRay(left.world_T_camera, left.intrinsics, {u, v}),
+                            PixelRay(right.world_T_camera, right.intrinsics, {u - d, v}));
+    if (!tri) return std::nullopt;
+    p.corners_W[c] = tri->p_W;
+  }
+  // Matching precision and fit residual, in level pixels, at the level's scale.
+  SetDepthSigma(&p, left, right.world_T_camera.translation(),
+                s * std::max(kMatchSigmaPx, b.fit.rms_px));
+  return p;
+}
+
+// Patches over the part of a level the finer one does not cover. Peripheral
+// blocks keep about the same size in the image at every level (the paper's
+// were about twice the foveal ones), but never fewer than 4 x 4 of the
+// level's pixels; their fit tolerance shrinks with the level so that it stays
+// near a full-resolution pixel and a plane cannot bridge a depth step.
+// Returns how many were added.
+int LevelPatches(const rig::StereoFrame& frame, const Tessellation& t, const Level& level,
+                 const cv::Mat& disparity, const FovealOptions& options, int fixation,
+                 PatchMap* patches) {
   const int size = level.index == 0 ? options.fovea_patch_px
                                     : std::max(4, options.periphery_patch_px >> level.index);
   PlaneFitOptions fit_options = options.plane_fit;
-  if (level.index > 0) {
-    fit_options.fit_tolerance_px = std::max(0.25, options.plane_fit.fit_tolerance_px / s);
-    fit_options.min_support = std::min(options.plane_fit.min_support, (3 * size * size) / 4);
-  }
+  if (level.index > 0)
+    fit_options.fit_tolerance_px = std::max(0.25, options.plane_fit.fit_tolerance_px / level.scale);
+  const cv::Rect inner = level.index > 0 ? t.rects[level.index - 1] : cv::Rect();
+  auto in_level = [&](int bx, int by, int block) {
+    const cv::Point centre(static_cast<int>((bx + 0.5 * block) * level.scale - 0.5),
+                           static_cast<int>((by + 0.5 * block) * level.scale - 0.5));
+    return level.rect.contains(centre) && !(level.index > 0 && inner.contains(centre));
+  };
   int added = 0;
-  for (int by = 0; by + size <= disparity.rows; by += size)
-    for (int bx = 0; bx + size <= disparity.cols; bx += size) {
-      const cv::Point centre(static_cast<int>((bx + 0.5 * size) * s - 0.5),
-                             static_cast<int>((by + 0.5 * size) * s - 0.5));
-      if (!level.rect.contains(centre) || (level.index > 0 && inner.contains(centre))) continue;
-      std::vector<DisparitySample> samples;
-      for (int y = by; y < by + size; ++y)
-        for (int x = bx; x < bx + size; ++x) {
-          const float d = disparity.at<float>(y, x);
-          if (std::isfinite(d)) samples.push_back({double(x), double(y), d});
-        }
-      const auto fit = FitDisparityPlane(samples, bx, by, size, fit_options);
-      if (!fit) continue;
-      Patch p;
-      p.level = level.index == 0 ? PatchLevel::kFoveal : PatchLevel::kPeripheral;
-      p.resolution_level = level.index;
-      p.fixation = fixation;
-      p.fit_rms_px = fit->rms_px;
-      p.support = fit->support;
-      const double xs[4] = {bx - 0.5, bx + size - 0.5, bx + size - 0.5, bx - 0.5};
-      const double ys[4] = {by - 0.5, by - 0.5, by + size - 0.5, by + size - 0.5};
-      bool ok = true;
-      for (int c = 0; c < 4 && ok; ++c) {
-        const double d = (*fit)(xs[c], ys[c]) * s;
-        const double u = (xs[c] + 0.5) * s - 0.5, v = (ys[c] + 0.5) * s - 0.5;
-        const auto tri =
-            TriangulateMidpoint(PixelRay(left.world_T_camera, left.intrinsics, {u, v}),
-                                PixelRay(right.world_T_camera, right.intrinsics, {u - d, v}));
-        ok = tri.has_value();
-        if (ok) p.corners_W[c] = tri->p_W;
-      }
-      if (!ok) continue;
-      patches->Add(p);
+  for (const BlockFit& b : FitBlocks(disparity, size, fit_options, options.min_fill_share,
+                                     options.min_block_px, in_level))
+    if (const auto p = BlockPatch(frame, level, b, fixation)) {
+      patches->Add(*p);
       ++added;
     }
   return added;
@@ -234,7 +261,7 @@ FovealResult FovealStereo(const rig::StereoFrame& frame, const Eigen::Vector3d& 
     DisparityMap dm = matcher.Match(level.left, level.right, ranges.lo, ranges.hi);
     const int outside_band =
         options.silent_near_m > 0 ? DropOutsideBand(level, matcher, ranges, options, &dm) : 0;
-    result.disparity_px[index] = dm.disparity_px;
+
     LevelFigures& fig = result.levels[index];
     fig.level = index;
     fig.rect = level.rect;
@@ -242,12 +269,55 @@ FovealResult FovealStereo(const rig::StereoFrame& frame, const Eigen::Vector3d& 
     fig.matched = dm.matched - outside_band;
     fig.outside_band = outside_band;
     fig.match_time_s = Since(t0);
+    fig.eroded =
+        ErodeAtDisparityJumps(options.edge_erosion_px, options.edge_jump_px, &dm.disparity_px);
     fig.patches =
         LevelPatches(frame, t, level, dm.disparity_px, options, fixation, &result.patches);
+    result.disparity_px[index] = dm.disparity_px;
   }
   result.compute_time_s = Since(t_start);
   return result;
 }
+
+namespace {
+
+// Why a fixation point the servo settled on cannot be trusted, given the
+// map: along the left optical axis the map shows a certain surface (its
+// depth sigma within kCertainShare of its depth) behind the point, beyond
+// their combined uncertainty (the servo's point: its depth from the pair's
+// baseline and the servo's residual, at least half a pixel). The point then
+// lies in free space: a false match, a repeated texture's copy. A point
+// behind the map's surface is accepted: where the map is wrong (a nearer
+// surface's patch reaching over its edge), that is what the camera sees.
+// nullopt when the map agrees, is silent or is not certain.
+std::optional<std::string> DisagreesWithMap(const rig::StereoFrame& frame,
+                                            const Eigen::Vector3d& fixation_W, double depth_m,
+                                            double residual_px, const PatchMap& map) {
+  const Eigen::Vector3d origin = frame.left.world_T_camera.translation();
+  const Eigen::Vector3d axis = frame.left.world_T_camera.linear().col(2);
+  const auto hit = map.CastRay(origin, axis);
+  if (!hit) return std::nullopt;
+  const Patch& surface = map[hit->patch];
+  Patch point;  // the servo's measurement, as a patch of one point
+  point.corners_W = {fixation_W, fixation_W, fixation_W, fixation_W};
+  point.sigma_z_m =
+      DepthSigma(depth_m, std::max(0.5, std::abs(residual_px)), frame.left.intrinsics.fx_px,
+                 frame.right.world_T_camera.translation() - origin, axis);
+  constexpr double kCertainShare = 0.01;
+  if (depth_m >= hit->distance_m ||
+      PatchMap::SameSurface(depth_m, point, hit->distance_m, surface) ||
+      !(surface.sigma_z_m <= kCertainShare * hit->distance_m))
+    return std::nullopt;
+  char why[200];
+  std::snprintf(why, sizeof why,
+                "servoing settled at %.3f m, in front of the surface the map holds on the optical "
+                "axis at %.3f m "
+                "(+-%.1f mm): a false match in free space",
+                depth_m, hit->distance_m, 1e3 * surface.sigma_z_m);
+  return std::string(why);
+}
+
+}  // namespace
 
 FixationResult Fixate(rig::Rig& rig, const PatchMap& map, const Eigen::Vector3d& p_W,
                       const StereoMatcher& matcher, const FixationOptions& options, int fixation,
@@ -302,6 +372,9 @@ FixationResult Fixate(rig::Rig& rig, const PatchMap& map, const Eigen::Vector3d&
   if (depth < options.min_depth_m)
     return refuse("servoing settled at " + std::to_string(depth) +
                   " m, nearer than idr.z_min_m: a false match");
+  if (options.map_check)
+    if (const auto why = DisagreesWithMap(frame, r.fixation_W, depth, r.servo.residual_px, map))
+      return refuse(*why);
   r.foveal = FovealStereo(frame, r.fixation_W, map, matcher, options.foveal, fixation);
   r.compute_time_s = verge_s + r.foveal.compute_time_s;
   r.ok = true;

@@ -287,7 +287,12 @@ PatchMap PatchesFromDisparities(const std::vector<DisparitySample>& samples,
         const double z = k.fx_px * baseline_m / d;
         p.corners_W[c] = left.world_T_camera * (z * k.Ray({xs[c], ys[c]}));
       }
-      if (ok) map.Add(p);
+      if (!ok) continue;
+      // Crossings are located to about half a pixel, the fit no better.
+      const Eigen::Vector3d right_W =
+          left.world_T_camera.translation() + baseline_m * left.world_T_camera.linear().col(0);
+      SetDepthSigma(&p, left, right_W, std::max(0.5, fit->rms_px));
+      map.Add(p);
     }
   }
   return map;

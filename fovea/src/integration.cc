@@ -1,7 +1,9 @@
 #include "fovea/integration.h"
 
-#include <stdexcept>
-#include <string>
+#include <array>
+#include <cmath>
+#include <utility>
+#include <vector>
 
 #include "fovea/params.h"
 
@@ -9,29 +11,167 @@ namespace fovea {
 
 void IntegrationOptions::Check() const {
   rig::CheckParam(params::kIntegrationOverlapShare, overlap_share);
+  rig::CheckParam(params::kIntegrationContradictionShare, contradiction_share);
 }
 
-IntegrationStats Integrate(PatchMap* map, const PatchMap& fresh, const rig::CameraView& view,
+namespace {
+
+// Of two patches seen on one line of sight at different surfaces (depths za
+// and zb there), the one that yields: the less precise measurement, or at
+// equal precision the coarser, or at equal fineness the older (`a_is_old`).
+// True when `a` yields. Precision is sigma_Z / Z^2 (that is sigma_d / (f B)):
+// sigma_Z alone grows with depth and would always favour the nearer of the
+// two, a window's fattening over an edge included.
+bool Yields(const Patch& a, double za, const Patch& b, double zb, bool a_is_old) {
+  const double pa = a.sigma_z_m / (za * za), pb = b.sigma_z_m / (zb * zb);
+  if (pa != pb) return pa > pb;
+  if (a.Fineness() != b.Fineness()) return a.Fineness() < b.Fineness();
+  return a_is_old;
+}
+
+// Moves each corner of `fresh` along its viewing ray to the inverse-variance
+// mean of its depth and the old map's where the old map shows the same
+// surface there at the same or a finer level (the old patch seen just inside
+// the corner, its plane met by the corner's ray); the patch's sigma shrinks
+// accordingly. Returns whether any corner was fused.
+bool Fuse(const PatchMap& map, const cv::Mat& old_ids, const rig::CameraView& view, Patch* fresh) {
+  const Eigen::Isometry3d camera_T_world = view.world_T_camera.inverse();
+  const Eigen::Vector3d origin = view.world_T_camera.translation();
+  const rig::CameraIntrinsics& k = view.intrinsics;
+  const Eigen::Vector3d centre = fresh->Centre();
+  double old_var_sum = 0;
+  int fused = 0;
+  for (Eigen::Vector3d& corner : fresh->corners_W) {
+    const Eigen::Vector3d inside = camera_T_world * (corner + 0.1 * (centre - corner));
+    if (inside.z() <= 0) continue;
+    const int u = static_cast<int>(std::lround(k.fx_px * inside.x() / inside.z() + k.cx_px));
+    const int v = static_cast<int>(std::lround(k.fy_px * inside.y() / inside.z() + k.cy_px));
+    if (u < 0 || v < 0 || u >= old_ids.cols || v >= old_ids.rows || old_ids.at<int>(v, u) < 0)
+      continue;
+    const Patch& old = map[old_ids.at<int>(v, u)];
+    // The old patch's plane along the corner's ray.
+    const Eigen::Vector3d ray = (corner - origin).normalized(), n = old.Normal();
+    const double denom = ray.dot(n);
+    if (std::abs(denom) < 1e-6) continue;
+    const double t_old = (old.Centre() - origin).dot(n) / denom, t_new = (corner - origin).norm();
+    const double along =
+        ray.dot(view.world_T_camera.linear().col(2));  // planar depth per unit range
+    if (old.Fineness() < fresh->Fineness() || !(old.sigma_z_m > 0) || !(fresh->sigma_z_m > 0) ||
+        !PatchMap::SameSurface(t_new * along, *fresh, t_old * along, old))
+      continue;
+    const double wn = 1 / (fresh->sigma_z_m * fresh->sigma_z_m),
+                 wo = 1 / (old.sigma_z_m * old.sigma_z_m);
+    corner = origin + ray * ((wn * t_new + wo * t_old) / (wn + wo));
+    old_var_sum += old.sigma_z_m * old.sigma_z_m;
+    ++fused;
+  }
+  if (fused == 0) return false;
+  // The fused sigma, with the mean variance of the old observations met.
+  const double old_var = old_var_sum / fused, new_var = fresh->sigma_z_m * fresh->sigma_z_m;
+  const double share = double(fused) / 4;
+  fresh->sigma_z_m =
+      std::sqrt((1 - share) * new_var + share * (new_var * old_var / (new_var + old_var)));
+  return true;
+}
+
+// The share of a patch's projected footprint that falls inside the view's
+// image (the projected quadrilateral clipped to the image rectangle, by
+// area). 0 when a corner lies behind the camera.
+double InViewShare(const Patch& p, const rig::CameraView& view) {
+  const Eigen::Isometry3d camera_T_world = view.world_T_camera.inverse();
+  const rig::CameraIntrinsics& k = view.intrinsics;
+  std::vector<Eigen::Vector2d> poly;
+  for (const Eigen::Vector3d& c : p.corners_W) {
+    const Eigen::Vector3d q = camera_T_world * c;
+    if (q.z() <= 1e-9) return 0;
+    poly.emplace_back(k.fx_px * q.x() / q.z() + k.cx_px, k.fy_px * q.y() / q.z() + k.cy_px);
+  }
+  auto area = [](const std::vector<Eigen::Vector2d>& v) {
+    double a = 0;
+    for (size_t i = 0; i < v.size(); ++i) {
+      const Eigen::Vector2d &p0 = v[i], &p1 = v[(i + 1) % v.size()];
+      a += p0.x() * p1.y() - p1.x() * p0.y();
+    }
+    return std::abs(a) / 2;
+  };
+  const double whole = area(poly);
+  if (!(whole > 0)) return 0;
+  // Sutherland-Hodgman against the four sides of [-0.5, w - 0.5] x [-0.5, h - 0.5].
+  const double lo = -0.5, w = k.width_px - 0.5, h = k.height_px - 0.5;
+  const std::array<std::pair<int, double>, 4> sides{
+      {{0, lo}, {1, lo}, {2, w}, {3, h}}};  // x >= lo, y >= lo, x <= w, y <= h
+  for (const auto& [side, bound] : sides) {
+    auto inside = [&, side = side, bound = bound](const Eigen::Vector2d& v) {
+      return side == 0   ? v.x() >= bound
+             : side == 1 ? v.y() >= bound
+             : side == 2 ? v.x() <= bound
+                         : v.y() <= bound;
+    };
+    auto cut = [&, side = side, bound = bound](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+      const double t =
+          (side % 2 == 0) ? (bound - a.x()) / (b.x() - a.x()) : (bound - a.y()) / (b.y() - a.y());
+      return Eigen::Vector2d(a + t * (b - a));
+    };
+    std::vector<Eigen::Vector2d> out;
+    for (size_t i = 0; i < poly.size(); ++i) {
+      const Eigen::Vector2d &cur = poly[i], &prev = poly[(i + poly.size() - 1) % poly.size()];
+      if (inside(cur)) {
+        if (!inside(prev)) out.push_back(cut(prev, cur));
+        out.push_back(cur);
+      } else if (inside(prev)) {
+        out.push_back(cut(prev, cur));
+      }
+    }
+    poly = std::move(out);
+    if (poly.empty()) return 0;
+  }
+  return area(poly) / whole;
+}
+
+}  // namespace
+
+IntegrationStats Integrate(PatchMap* map, const PatchMap& fresh_in, const rig::CameraView& view,
                            const IntegrationOptions& options) {
   IntegrationStats stats;
-  stats.offered = static_cast<int>(fresh.size());
-  cv::Mat old_ids, new_ids;
-  map->Render(view.world_T_camera, view.intrinsics, nullptr, &old_ids);
-  fresh.Render(view.world_T_camera, view.intrinsics, nullptr, &new_ids);
-  const size_t n_old = map->size(), n_new = fresh.size();
-  auto level = [](const Patch& p) { return p.Fineness(); };
-
-  // Footprint of each new patch, and how much of it finer old data shows.
-  std::vector<int> footprint(n_new, 0), under_finer(n_new, 0);
-  for (int y = 0; y < new_ids.rows; ++y) {
-    const int* nr = new_ids.ptr<int>(y);
-    const int* orow = old_ids.ptr<int>(y);
-    for (int x = 0; x < new_ids.cols; ++x) {
-      if (nr[x] < 0) continue;
-      ++footprint[nr[x]];
-      if (orow[x] >= 0 && level((*map)[orow[x]]) > level(fresh[nr[x]])) ++under_finer[nr[x]];
+  stats.offered = static_cast<int>(fresh_in.size());
+  cv::Mat old_depth, old_ids, new_depth, new_ids;
+  map->Render(view.world_T_camera, view.intrinsics, &old_depth, &old_ids);
+  PatchMap fresh = fresh_in;
+  if (options.fuse) {
+    PatchMap fused;
+    for (const Patch& p : fresh.patches()) {
+      Patch q = p;
+      stats.fused += Fuse(*map, old_ids, view, &q);
+      fused.Add(q);
     }
+    fresh = std::move(fused);
   }
+  fresh.Render(view.world_T_camera, view.intrinsics, &new_depth, &new_ids);
+  const size_t n_old = map->size(), n_new = fresh.size();
+
+  // Per pixel: each new patch's footprint, how much of it shows the same
+  // surface at a finer level in the map; each old patch's visible footprint;
+  // and, where the two show different surfaces on one line of sight, a vote
+  // against the one that yields (the camera that saw the farther surface saw
+  // through the nearer one: one of them is wrong).
+  std::vector<int> footprint(n_new, 0), under_finer(n_new, 0), new_votes(n_new, 0);
+  std::vector<int> visible(n_old, 0), old_votes(n_old, 0);
+  for (int y = 0; y < new_ids.rows; ++y)
+    for (int x = 0; x < new_ids.cols; ++x) {
+      const int n = new_ids.at<int>(y, x), o = old_ids.at<int>(y, x);
+      if (n >= 0) ++footprint[n];
+      if (o >= 0) ++visible[o];
+      if (n < 0 || o < 0) continue;
+      const Patch &pn = fresh[n], &po = (*map)[o];
+      const double zn = new_depth.at<float>(y, x), zo = old_depth.at<float>(y, x);
+      if (PatchMap::SameSurface(zn, pn, zo, po)) {
+        if (po.Fineness() > pn.Fineness()) ++under_finer[n];
+      } else if (Yields(po, zo, pn, zn, /*a_is_old=*/true)) {
+        ++old_votes[o];
+      } else {
+        ++new_votes[n];
+      }
+    }
   std::vector<char> keep(n_new, 1);
   for (size_t k = 0; k < n_new; ++k) {
     if (footprint[k] == 0) {
@@ -39,27 +179,33 @@ IntegrationStats Integrate(PatchMap* map, const PatchMap& fresh, const rig::Came
     } else if (under_finer[k] > options.overlap_share * footprint[k]) {
       keep[k] = 0;
       ++stats.dropped_under_finer;
+    } else if (new_votes[k] > options.contradiction_share * footprint[k]) {
+      keep[k] = 0;
+      ++stats.dropped_contradicted;
     }
   }
-  // Old patches: the share of their visible footprint that kept new patches
-  // of their level or finer cover.
-  std::vector<int> visible(n_old, 0), covered(n_old, 0);
-  for (int y = 0; y < old_ids.rows; ++y) {
-    const int* nr = new_ids.ptr<int>(y);
-    const int* orow = old_ids.ptr<int>(y);
+  // Old patches: removed when contradicted, or when kept new patches of their
+  // level or finer cover the overlap share of their visible footprint and
+  // that footprint is the patch (not a sliver of a patch mostly outside the
+  // view, whose rest nothing replaces).
+  std::vector<int> covered(n_old, 0);
+  for (int y = 0; y < old_ids.rows; ++y)
     for (int x = 0; x < old_ids.cols; ++x) {
-      if (orow[x] < 0) continue;
-      ++visible[orow[x]];
-      if (nr[x] >= 0 && keep[nr[x]] && level(fresh[nr[x]]) >= level((*map)[orow[x]]))
-        ++covered[orow[x]];
+      const int n = new_ids.at<int>(y, x), o = old_ids.at<int>(y, x);
+      if (o >= 0 && n >= 0 && keep[n] && fresh[n].Fineness() >= (*map)[o].Fineness()) ++covered[o];
     }
-  }
   std::vector<char> drop(n_old, 0);
-  for (size_t j = 0; j < n_old; ++j)
-    if (visible[j] > 0 && covered[j] >= options.overlap_share * visible[j]) {
+  for (size_t j = 0; j < n_old; ++j) {
+    if (visible[j] == 0) continue;
+    if (old_votes[j] > options.contradiction_share * visible[j]) {
+      drop[j] = 1;
+      ++stats.removed_contradicted[static_cast<int>((*map)[j].level)];
+    } else if (covered[j] >= options.overlap_share * visible[j] &&
+               InViewShare((*map)[j], view) >= options.overlap_share) {
       drop[j] = 1;
       ++stats.replaced[static_cast<int>((*map)[j].level)];
     }
+  }
   map->Remove(drop);
   for (size_t k = 0; k < n_new; ++k)
     if (keep[k]) {

@@ -31,6 +31,27 @@ double Patch::SizeM() const {
   return std::max((corners_W[2] - corners_W[0]).norm(), (corners_W[3] - corners_W[1]).norm());
 }
 
+double DepthSigma(double z_m, double sigma_d_px, double focal_px, const Eigen::Vector3d& baseline_W,
+                  const Eigen::Vector3d& ray_W) {
+  const double b_perp = baseline_W.cross(ray_W.normalized()).norm();
+  if (!(b_perp > 1e-9) || !(focal_px > 0)) return std::numeric_limits<double>::infinity();
+  return z_m * z_m * sigma_d_px / (focal_px * b_perp);
+}
+
+void SetDepthSigma(Patch* patch, const rig::CameraView& left, const Eigen::Vector3d& right_centre_W,
+                   double sigma_d_px) {
+  const Eigen::Vector3d c_W = patch->Centre(), left_W = left.world_T_camera.translation();
+  const double z = (left.world_T_camera.inverse() * c_W).z();
+  patch->sigma_z_m =
+      DepthSigma(z, sigma_d_px, left.intrinsics.fx_px, right_centre_W - left_W, c_W - left_W);
+}
+
+bool PatchMap::SameSurface(double za, const Patch& a, double zb, const Patch& b) {
+  const double band = std::max(kSameSurfaceShare * std::min(za, zb),
+                               kSameSurfaceSigmas * std::hypot(a.sigma_z_m, b.sigma_z_m));
+  return std::abs(za - zb) <= band;
+}
+
 void PlaneFitOptions::Check(const rig::ParamSpec& min_support_spec,
                             const rig::ParamSpec& fit_tolerance_spec,
                             const rig::ParamSpec& min_inlier_share_spec) const {
@@ -95,6 +116,52 @@ std::optional<PlaneFit> FitDisparityPlane(const std::vector<DisparitySample>& sa
   fit.rms_px = std::sqrt(ss / fit.support);
   if (inlier_box) *inlier_box = box;
   return fit;
+}
+
+namespace {
+
+void FitBlock(const cv::Mat& disparity, int bx, int by, int size, const PlaneFitOptions& options,
+              double min_fill_share, int min_block_px, std::vector<BlockFit>* out) {
+  PlaneFitOptions o = options;
+  o.min_support = std::min(options.min_support, (3 * size * size) / 4);
+  std::vector<DisparitySample> samples;
+  for (int y = by; y < std::min(by + size, disparity.rows); ++y)
+    for (int x = bx; x < std::min(bx + size, disparity.cols); ++x) {
+      const float d = disparity.at<float>(y, x);
+      if (std::isfinite(d)) samples.push_back({double(x), double(y), d});
+    }
+  if (samples.empty()) return;
+  const auto fit = FitDisparityPlane(samples, bx, by, size, o);
+  // One plane for the whole block when its inliers fill it and it has next
+  // to no outliers (measurements of another surface); else its quarters
+  // are tried, and a smallest block that is not whole is left out.
+  const int outliers = fit ? static_cast<int>(samples.size()) - fit->support : 0;
+  const bool whole = min_fill_share <= 0
+                         ? fit.has_value()
+                         : fit && fit->support >= min_fill_share * size * size &&
+                               outliers <= std::max(1.0, 0.05 * double(samples.size()));
+  if (whole) {
+    out->push_back({bx, by, size, *fit});
+    return;
+  }
+  const int half = size / 2;
+  if (min_fill_share <= 0 || half < min_block_px) return;
+  for (int q = 0; q < 4; ++q)
+    FitBlock(disparity, bx + (q % 2) * half, by + (q / 2) * half, half, options, min_fill_share,
+             min_block_px, out);
+}
+
+}  // namespace
+
+std::vector<BlockFit> FitBlocks(const cv::Mat& disparity, int size, const PlaneFitOptions& options,
+                                double min_fill_share, int min_block_px,
+                                const std::function<bool(int x, int y, int size)>& keep) {
+  std::vector<BlockFit> out;
+  for (int by = 0; by + size <= disparity.rows; by += size)
+    for (int bx = 0; bx + size <= disparity.cols; bx += size)
+      if (!keep || keep(bx, by, size))
+        FitBlock(disparity, bx, by, size, options, min_fill_share, min_block_px, &out);
+  return out;
 }
 
 namespace {
@@ -334,7 +401,7 @@ void PatchMap::Render(const Eigen::Isometry3d& world_T_camera, const rig::Camera
           float& d = depth.at<float>(v, u);
           int& id = ids.at<int>(v, u);
           bool take = d == 0 || z < d;
-          if (d != 0 && std::abs(z - d) <= kSameSurfaceShare * d) {
+          if (d != 0 && SameSurface(z, patches_[i], d, patches_[id])) {
             // The same surface seen twice: the finer level wins.
             const int mine = patches_[i].Fineness(), theirs = patches_[id].Fineness();
             take = mine > theirs || (mine == theirs && z < d);

@@ -135,6 +135,49 @@ std::optional<double> CentreDisparity(const rig::StereoFrame& frame, const Servo
                    static_cast<int>(std::ceil(hi)) + 1, o.unique_ratio);
 }
 
+bool UniqueAlongRay(const rig::StereoFrame& frame, const Eigen::Vector2d& pixel,
+                    const DepthRange& depths, const ServoOptions& o) {
+  const cv::Mat& l = frame.left.gray;
+  const cv::Mat& r = frame.right.gray;
+  const int h = o.window_half_px;
+  const int xl = static_cast<int>(std::lround(pixel.x())),
+            yl = static_cast<int>(std::lround(pixel.y()));
+  if (xl - h < 0 || yl - h < 0 || xl + h >= l.cols || yl + h >= l.rows) return false;
+  if (NormalizedL1(l, xl, yl, cv::Mat(l.size(), CV_8U, cv::Scalar(0)), xl, yl, h) < 2.0)
+    return false;
+  // The ray's points by inverse depth, about a pixel apart in the right image.
+  const Eigen::Vector3d ray_L = frame.left.intrinsics.Ray(pixel);
+  const Eigen::Isometry3d right_T_left =
+      frame.right.world_T_camera.inverse() * frame.left.world_T_camera;
+  auto project = [&](double inverse_depth) -> std::optional<Eigen::Vector2d> {
+    const Eigen::Vector3d p = right_T_left * (ray_L / std::max(inverse_depth, 1e-9));
+    if (p.z() <= 1e-6) return std::nullopt;
+    return frame.right.intrinsics.Project(p);
+  };
+  const double w_near = 1 / depths.near_m, w_far = 1 / depths.far_m;
+  const auto a = project(w_near), b = project(w_far);
+  if (!a || !b) return false;
+  const int n = std::clamp(static_cast<int>(std::ceil((*a - *b).norm())) + 1, 3, 2000);
+  std::vector<double> cost(n, 1e300);
+  int best = -1;
+  for (int i = 0; i < n; ++i) {
+    const auto uv = project(w_far + (w_near - w_far) * i / (n - 1));
+    if (!uv) continue;
+    const int xr = static_cast<int>(std::lround(uv->x())),
+              yr = static_cast<int>(std::lround(uv->y()));
+    if (xr - h < 0 || yr - h < 0 || xr + h >= r.cols || yr + h >= r.rows) continue;
+    cost[i] = NormalizedL1(l, xl, yl, r, xr, yr, h);
+    if (best < 0 || cost[i] < cost[best]) best = i;
+  }
+  if (best <= 0 || best >= n - 1 || cost[best - 1] >= 1e300 || cost[best + 1] >= 1e300)
+    return false;
+  for (int i = 1; i + 1 < n; ++i) {
+    const bool local_min = cost[i] <= cost[i - 1] && cost[i] <= cost[i + 1] && cost[i] < 1e300;
+    if (local_min && std::abs(i - best) > h && cost[best] >= o.unique_ratio * cost[i]) return false;
+  }
+  return true;
+}
+
 ServoResult Servo(rig::Rig& rig, const rig::StageState& start, const ServoOptions& o,
                   const std::optional<DepthRange>& first_depths) {
   ServoResult result;

@@ -10,8 +10,8 @@
 namespace scenes {
 
 std::vector<std::string> CatalogNames() {
-  return {"fronto_planes", "cylinder_planes", "two_planes", "three_surfaces", "periodic", "textureless",
-          "sphere_wall",   "staircase",       "post_slant", "random"};
+  return {"fronto_planes", "cylinder_planes", "two_planes", "three_surfaces", "periodic",
+          "textureless",   "sphere_wall",     "staircase",  "post_slant",     "random"};
 }
 
 std::string ScenesDir() {

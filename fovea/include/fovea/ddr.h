@@ -35,6 +35,11 @@ struct FoveaOptions {
   /// Beyond the paper: pixels the map is silent at are fixation candidates
   /// too, at the depth of the nearest mapped pixel (SelectionContext::Make).
   bool fixate_holes = true;
+  /// Beyond the paper: a hole chosen as the next target is first looked at
+  /// in the current pair; if its window has no unique match along its ray
+  /// (UniqueAlongRay over every depth from idr.z_min_m), it is passed over
+  /// without moving the rig, as a refused point would be.
+  bool prescreen_holes = true;
   /// Beyond the paper: where the map is silent, the fovea also searches every
   /// depth from idr.z_min_m (the scene's nearest) to infinity and drops Z_T
   /// matches that search contradicts (sets FovealOptions::silent_near_m;

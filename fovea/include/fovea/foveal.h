@@ -39,6 +39,18 @@ struct FovealOptions {
   /// 0: the paper's band search only.
   double silent_near_m = 0;
   double silent_confidence = 0.2;
+  /// Beyond the paper: pixels within this many level pixels of a pixel whose
+  /// disparity is more than edge_jump_px smaller are dropped before the
+  /// patches are fitted (window matching fattens a nearer surface over a
+  /// farther one's pixels beside their edge); 0: none. A window's half width.
+  int edge_erosion_px = 3;
+  double edge_jump_px = 1.5;
+  /// Beyond the paper: a block becomes one patch only if its inliers fill
+  /// this share of it; else it is split into quarters (down to min_block_px
+  /// level pixels), so that no patch reaches over a depth edge or a strip
+  /// without data (0: the paper's whole blocks).
+  double min_fill_share = 0.5;
+  int min_block_px = 4;
   void Check() const;  ///< throws rig::InputError naming the key (fovea/params.h)
 };
 
@@ -49,6 +61,7 @@ struct LevelFigures {
   int searched = 0, matched = 0, patches = 0;
   int outside_band =
       0;  ///< band matches dropped: the wider search matched outside (FovealOptions::silent_near_m)
+  int eroded = 0;  ///< matches dropped beside a disparity jump (FovealOptions::edge_erosion_px)
   double match_time_s = 0;
 };
 
@@ -89,6 +102,10 @@ struct FixationOptions {
   /// servo that settles nearer took a false match (a repeated texture's
   /// copy) and the point is refused before any matching (0: no check).
   double min_depth_m = 0;
+  /// Beyond the paper: a servo whose point lies in front of a surface the map
+  /// holds with certainty on the left optical axis (beyond their combined
+  /// uncertainty) is refused: a false match in free space.
+  bool map_check = true;
   void Check() const;  ///< throws rig::InputError naming the key (fovea/params.h)
 };
 

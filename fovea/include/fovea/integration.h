@@ -14,23 +14,39 @@ struct IntegrationOptions {
   /// patch is removed when at least this share of its visible footprint is
   /// covered by kept new patches of its level or finer.
   double overlap_share = 0.9;
+  /// Beyond the paper: where a new patch and the map show different surfaces
+  /// on one line of sight (beyond their combined uncertainty), the camera
+  /// that saw the farther one saw through the nearer: the less certain of
+  /// the two gets a vote, and a patch whose votes pass this share of its
+  /// footprint is dropped (new) or removed (old), whatever their levels
+  /// (1: never).
+  double contradiction_share = 0.25;
+  /// Beyond the paper: a new patch's corners are fused (inverse-variance
+  /// mean along the viewing ray) with the map's depth there where the map
+  /// shows the same surface at the same or a finer level.
+  bool fuse = true;
   void Check() const;  ///< throws rig::InputError naming the key (fovea/params.h)
 };
 
 struct IntegrationStats {
-  int offered = 0;              ///< new patches
-  int added = 0;                ///< kept and added to the map
-  int dropped_under_finer = 0;  ///< new patches dropped because finer data covers them
-  int added_outside_view = 0;   ///< new patches with no footprint in the view (added as they are)
-  std::array<int, 3> replaced{0, 0, 0};  ///< old patches removed, by their PatchLevel
+  int offered = 0;               ///< new patches
+  int added = 0;                 ///< kept and added to the map
+  int dropped_under_finer = 0;   ///< new patches dropped because finer data covers them
+  int added_outside_view = 0;    ///< new patches with no footprint in the view (added as they are)
+  int dropped_contradicted = 0;  ///< new patches dropped: the map contradicts them
+  int fused = 0;                 ///< new patches fused with the map's depth
+  std::array<int, 3> replaced{0, 0, 0};              ///< old patches removed, by their PatchLevel
+  std::array<int, 3> removed_contradicted{0, 0, 0};  ///< old patches new data contradicts, by level
 };
 
 /// Merges `fresh` into `map` by the replacement rule: a new patch replaces
 /// the old patches it covers in `view` whose level is the same or coarser
 /// (IDR < peripheral < foveal); new data never replaces finer old data. We
 /// refine "peripheral replaces peripheral": a coarser resolution level does
-/// not replace a finer one (Patch::Fineness). Cost:
-/// two renders into the view, O(N + M + pixels) for N old and M new patches.
+/// not replace a finer one (Patch::Fineness). Beyond the paper, new patches
+/// are fused with the map where both show one surface, and contradictions
+/// between them are settled by certainty (IntegrationOptions). Cost: three
+/// renders into the view, O(N + M + pixels) for N old and M new patches.
 /// `options` must have passed Check(): the run checks them once, before
 /// its work (RunFovea, RunIdr, RunConfig::Check), never per call.
 IntegrationStats Integrate(PatchMap* map, const PatchMap& fresh, const rig::CameraView& view,

@@ -88,6 +88,11 @@ inline constexpr ParamSpec kFovealLeftPair{"foveal.left_pair",
                                            "the left camera with itself at two carriage positions "
                                            "(the home pose's and foveal.baseline_m to its left; "
                                            "motion stereo, the scene must hold still)"};
+inline constexpr ParamSpec kFovealMapCheck{
+    "foveal.map_check",
+    "beyond the paper: refuse a fixation whose servoed point lies in front of a surface the map "
+    "holds with "
+    "certainty on the optical axis (a false match in free space)"};
 inline constexpr ParamSpec kFovealVergenceMaxIterations{
     "foveal.vergence_max_iterations", "vergence: Newton steps per camera", 1, 200};
 inline constexpr ParamSpec kFovealVergenceTolerancePx{
@@ -145,6 +150,22 @@ inline constexpr ParamSpec kFovealSilentConfidence{
     "foveal.silent_confidence",
     "see foveal.silent_check: the wider search's match confidence needed to drop a band match", 0,
     1};
+inline constexpr ParamSpec kFovealEdgeErosionPx{
+    "foveal.edge_erosion_px",
+    "beyond the paper: matches within this many level pixels of a disparity more than "
+    "foveal.edge_jump_px "
+    "smaller are dropped (window matching fattens a nearer surface over its edge; 0 = none)",
+    0, 10};
+inline constexpr ParamSpec kFovealEdgeJumpPx{
+    "foveal.edge_jump_px", "see foveal.edge_erosion_px: the disparity jump, level pixels", 0.1, 64};
+inline constexpr ParamSpec kFovealMinFillShare{
+    "foveal.min_fill_share",
+    "beyond the paper: a block is one patch only if its inliers fill this share of it, else it is "
+    "split into "
+    "quarters (0 = the paper's whole blocks)",
+    0, 1};
+inline constexpr ParamSpec kFovealMinBlockPx{
+    "foveal.min_block_px", "the smallest quarter a block is split into, level pixels", 2, 64};
 inline constexpr ParamSpec kFovealFitMinSupport{
     "foveal.fit_min_support",
     "foveal and peripheral patch fit: inlier measurements needed in a block", 3, 4096};
@@ -221,6 +242,18 @@ inline constexpr ParamSpec kIntegrationOverlapShare{
     "integration.overlap_share",
     "overlap share at which new patches replace old ones (and finer data blocks new ones)", 0.01,
     1};
+inline constexpr ParamSpec kIntegrationContradictionShare{
+    "integration.contradiction_share",
+    "beyond the paper: a patch the map contradicts (another surface on its line of sight, more "
+    "certain, beyond "
+    "their combined uncertainty) over more than this share of its footprint is dropped or removed "
+    "(1 = never)",
+    0, 1};
+inline constexpr ParamSpec kIntegrationFuse{
+    "integration.fuse",
+    "beyond the paper: fuse a new patch with the map's depth where the map shows the same surface "
+    "at the same or a "
+    "finer level (inverse-variance mean; false: the paper's replacement only)"};
 inline constexpr ParamSpec kLoopFixations{"loop.fixations", "successful fixations to make", 1,
                                           10000};
 inline constexpr ParamSpec kLoopStayInIdrView{
@@ -229,6 +262,11 @@ inline constexpr ParamSpec kLoopFixateHoles{"loop.fixate_holes",
                                             "beyond the paper: pixels the map is silent at are "
                                             "candidates, at the depth of the nearest mapped pixel "
                                             "(false: the paper's rule)"};
+inline constexpr ParamSpec kLoopPrescreenHoles{
+    "loop.prescreen_holes",
+    "beyond the paper: a hole chosen as the next target whose window has no unique match along its "
+    "ray in the "
+    "current pair is passed over without moving the rig (false: every hole is attempted)"};
 inline constexpr ParamSpec kLoopStallFixations{"loop.stall_fixations",
                                                "stop when the foveal share grew by less than "
                                                "stall_growth over this many fixations (0 = never)",

@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <array>
+#include <functional>
 #include <opencv2/core.hpp>
 #include <optional>
 #include <vector>
@@ -26,6 +27,10 @@ struct Patch {
   int resolution_level = 0;  ///< 0 = full resolution, k = downsampled 2^k
   double fit_rms_px = 0;     ///< RMS residual of its disparity-plane fit
   int support = 0;           ///< number of measurements in the fit
+  /// Standard deviation of its depth along the observing camera's axis at
+  /// its centre, metres (DepthSigma): what integration and the map's
+  /// rendering weigh observations by. 0: unknown (treated as certain).
+  double sigma_z_m = 0;
 
   /// Order of precedence between patches of the same surface: foveal over
   /// peripheral over IDR, and within a level the finer resolution first.
@@ -37,6 +42,25 @@ struct Patch {
   /// Diameter: the longer diagonal, metres.
   double SizeM() const;
 };
+
+/// Matching precision of a well-textured window at full resolution, pixels
+/// of disparity (sub-pixel refinement reaches 0.1 to 0.2 px; see FACTS).
+constexpr double kMatchSigmaPx = 0.15;
+
+/// Depth standard deviation of a point at planar depth `z_m` measured with a
+/// disparity standard deviation `sigma_d_px` (full-resolution pixels) by a
+/// pair whose optical centres differ by `baseline_W`, seen along `ray_W`:
+/// sigma_Z = Z^2 sigma_d / (f B_perp), B_perp the baseline's component
+/// perpendicular to the ray (a verged pair's effective baseline).
+double DepthSigma(double z_m, double sigma_d_px, double focal_px, const Eigen::Vector3d& baseline_W,
+                  const Eigen::Vector3d& ray_W);
+
+/// Sets patch->sigma_z_m for a patch measured by a stereo pair whose left
+/// camera is `left` and whose right optical centre is `right_centre_W`, with
+/// a disparity standard deviation `sigma_d_px` in full-resolution pixels: the
+/// depth sigma along the left camera's axis at the patch's centre.
+void SetDepthSigma(Patch* patch, const rig::CameraView& left, const Eigen::Vector3d& right_centre_W,
+                   double sigma_d_px);
 
 /// A disparity plane d(x, y) = a x + b y + c fitted over one block.
 struct PlaneFit {
@@ -77,6 +101,26 @@ std::optional<PlaneFit> FitDisparityPlane(const std::vector<DisparitySample>& sa
                                           double y0, double size, const PlaneFitOptions& options,
                                           Eigen::Vector4d* inlier_box = nullptr);
 
+/// One block of a disparity image fitted as one plane.
+struct BlockFit {
+  int x = 0, y = 0, size = 0;  ///< the block: [x, x + size) x [y, y + size), image pixels
+  PlaneFit fit;
+};
+
+/// Planes over the blocks of `size` pixels that tile `disparity` (CV_32F,
+/// NaN = no measurement) that `keep` accepts. With min_fill_share > 0 a
+/// block becomes one plane only if its inliers fill that share of it and
+/// next to none of its measurements are outliers (at most 5%, at least one);
+/// otherwise (a depth edge inside it, a strip without matches along one) it
+/// is split into quarters, recursively down to `min_block_px`, and a
+/// smallest block that is not whole is left out, so that no plane spans two
+/// surfaces. With min_fill_share = 0, every block whose fit succeeds (the
+/// paper's rule). The fit's min_support shrinks with the block (to 3/4 of
+/// its pixels).
+std::vector<BlockFit> FitBlocks(const cv::Mat& disparity, int size, const PlaneFitOptions& options,
+                                double min_fill_share, int min_block_px,
+                                const std::function<bool(int x, int y, int size)>& keep);
+
 /// Result of a ray query.
 struct PatchHit {
   double distance_m = 0;  ///< along the unit ray direction
@@ -116,15 +160,20 @@ class PatchMap {
   std::optional<PatchHit> CastRayBruteForce(const Eigen::Vector3d& origin_W,
                                             const Eigen::Vector3d& direction_W) const;
 
-  /// Depths within this share of each other at a pixel are the same surface.
+  /// Depths within this share of each other at a pixel are the same surface,
+  /// and so are depths within kSameSurfaceSigmas combined standard deviations
+  /// (SameSurface).
   static constexpr double kSameSurfaceShare = 0.02;
+  static constexpr double kSameSurfaceSigmas = 3.0;
+  /// Whether depths `za` and `zb` seen at one pixel by patches `a` and `b`
+  /// belong to one surface.
+  static bool SameSurface(double za, const Patch& a, double zb, const Patch& b);
 
   /// The map seen by a camera: planar depth (CV_32F, 0 where no patch) and
   /// the index of the patch seen per pixel (CV_32S, -1 where none), by
   /// z-buffered rasterization of every patch in front of the camera. Where
-  /// patches lie within kSameSurfaceShare of depth of each other, the one of
-  /// the finest level is seen (finer data supersedes coarser), else the
-  /// nearest.
+  /// patches are of the same surface (SameSurface), the one of the finest
+  /// level is seen (finer data supersedes coarser), else the nearest.
   void Render(const Eigen::Isometry3d& world_T_camera, const rig::CameraIntrinsics& intrinsics,
               cv::Mat* depth_m, cv::Mat* patch_ids) const;
 

@@ -164,6 +164,7 @@ struct SelectionSummary {
   Eigen::Vector2d pixel = Eigen::Vector2d::Zero();
   Eigen::Vector3d point_W = Eigen::Vector3d::Zero();
   bool in_hole = false;  ///< the pixel showed no map data: point_W is a guess
+  int prescreened = 0;   ///< holes passed over before this choice (FoveaOptions::prescreen_holes)
   int candidates = 0;    ///< pixels with a map point
   double composite_max = 0, composite_chosen = 0;
   double drawn_value = 0;  ///< c drawn from the exponential density
@@ -177,8 +178,6 @@ struct SelectionSummary {
 /// from the generator passed in.
 class FixationSelector {
  public:
-  /// The paper's four criteria with their default settings.
-
   FixationSelector(std::vector<std::shared_ptr<const FixationCriterion>> criteria,
                    const SelectionOptions& options);
 

@@ -59,6 +59,16 @@ std::optional<double> CentreDisparity(const rig::StereoFrame& frame, const Servo
 std::optional<double> CentreDisparity(const rig::StereoFrame& frame, const ServoOptions& options,
                                       const DepthRange& depths);
 
+/// Whether the left image's window at `pixel` has one clear match among the
+/// right image's windows at the projections of the depths [near, far] along
+/// its ray (normalized L1, windows of options.window_half_px, unique as in
+/// the depth-range CentreDisparity: no other minimum within
+/// options.unique_ratio of the best, and the best not at the range's end).
+/// For any pair, verged or not: the loop asks it of a hole before moving
+/// the rig there, from the images it has.
+bool UniqueAlongRay(const rig::StereoFrame& frame, const Eigen::Vector2d& pixel,
+                    const DepthRange& depths, const ServoOptions& options);
+
 /// The reverse of CentreDisparity: where the right image's centre window
 /// appears in the left image, searched +- options.search_px along its row,
 /// against where the left centre's match `residual_px` (CentreDisparity's

@@ -18,7 +18,7 @@ struct TessellationOptions {
   /// is the depth offset at which a point on the left optical axis reaches
   /// half of it.
   double horizontal_disparity_limit_px = 32;
-  int max_levels = 4;  ///< level k samples every 2^k pixels
+  int max_levels = 2;  ///< level k samples every 2^k pixels (the paper: 4; see README)
   void Check() const;  ///< throws rig::InputError naming the key (fovea/params.h)
 };
 

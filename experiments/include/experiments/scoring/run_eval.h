@@ -93,7 +93,18 @@ struct MapScore {
   bool has_patch_error = false;
   double patch_error_median_m = 0, patch_error_p90_m = 0;
   int patches_scored = 0;
+  /// With the per-patch figures: IDR patches whose footprint in the reference
+  /// view finer (peripheral or foveal) patches cover, at least
+  /// kStaleCoveredShare of it, whatever their depths: coarse data the
+  /// replacement rule should have removed.
+  int stale_idr_patches = 0;
 };
+
+inline constexpr double kStaleCoveredShare = 0.9;
+
+/// The IDR patches of `map` whose footprint in `view` its finer patches
+/// cover (MapScore::stale_idr_patches).
+int StaleIdrPatches(const fovea::PatchMap& map, const rig::CameraView& view);
 
 /// Scores `map` in the reference view; `baseline_m` sets the disparity step.
 MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref,
