@@ -172,6 +172,31 @@ int StaleIdrPatches(const fovea::PatchMap& map, const rig::CameraView& view) {
   return stale;
 }
 
+namespace {
+
+// Each patch's 3D error: the distance from its centre to the true surface
+// along its normal (either way); and the IDR patches finer data has made stale.
+void ScorePatches(const fovea::PatchMap& map, const rig::CameraView& view,
+                  const sim::GroundTruth& truth, MapScore* s) {
+  s->has_patch_error = true;
+  std::vector<double> err;
+  for (const fovea::Patch& p : map.patches()) {
+    const Eigen::Vector3d c = p.Centre(), n = p.Normal();
+    double best = std::numeric_limits<double>::infinity();
+    for (const double sign : {1.0, -1.0}) {
+      const auto hit = truth.CastRay(c, sign * n);
+      if (hit) best = std::min(best, hit->distance_m);
+    }
+    if (std::isfinite(best)) err.push_back(best);
+  }
+  s->patches_scored = static_cast<int>(err.size());
+  s->patch_error_median_m = Quantile(err, 0.5);
+  s->patch_error_p90_m = Quantile(err, 0.9);
+  s->stale_idr_patches = StaleIdrPatches(map, view);
+}
+
+}  // namespace
+
 MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref,
                   const sim::GroundTruth& truth, double baseline_m, bool per_patch) {
   MapScore s;
@@ -237,23 +262,7 @@ MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref,
     sf.rmse_m = e.rmse_m;
     s.surfaces.push_back(sf);
   }
-  if (per_patch) {
-    s.has_patch_error = true;
-    std::vector<double> err;
-    for (const fovea::Patch& p : map.patches()) {
-      const Eigen::Vector3d c = p.Centre(), n = p.Normal();
-      double best = std::numeric_limits<double>::infinity();
-      for (const double sign : {1.0, -1.0}) {
-        const auto hit = truth.CastRay(c, sign * n);
-        if (hit) best = std::min(best, hit->distance_m);
-      }
-      if (std::isfinite(best)) err.push_back(best);
-    }
-    s.patches_scored = static_cast<int>(err.size());
-    s.patch_error_median_m = Quantile(err, 0.5);
-    s.patch_error_p90_m = Quantile(err, 0.9);
-    s.stale_idr_patches = StaleIdrPatches(map, ref.view);
-  }
+  if (per_patch) ScorePatches(map, ref.view, truth, &s);
   return s;
 }
 

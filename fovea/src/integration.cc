@@ -128,6 +128,42 @@ double InViewShare(const Patch& p, const rig::CameraView& view) {
   return area(poly) / whole;
 }
 
+// The new patches, each fused with the map's patches of the same surface.
+PatchMap FuseAll(const PatchMap& map, const cv::Mat& old_ids, const rig::CameraView& view,
+                 const PatchMap& fresh, int* fused) {
+  PatchMap out;
+  for (const Patch& p : fresh.patches()) {
+    Patch q = p;
+    *fused += Fuse(map, old_ids, view, &q);
+    out.Add(q);
+  }
+  return out;
+}
+
+// Which old patches go: those contradicted over the contradiction share of
+// their visible footprint, and those whose visible footprint kept new
+// patches of their level or finer cover (by the overlap share) when that
+// footprint is the patch, not a sliver of a patch mostly outside the view.
+std::vector<char> OldPatchesToDrop(const PatchMap& map, const rig::CameraView& view,
+                                   const std::vector<int>& visible,
+                                   const std::vector<int>& old_votes,
+                                   const std::vector<int>& covered,
+                                   const IntegrationOptions& options, IntegrationStats* stats) {
+  std::vector<char> drop(map.size(), 0);
+  for (size_t j = 0; j < map.size(); ++j) {
+    if (visible[j] == 0) continue;
+    if (old_votes[j] > options.contradiction_share * visible[j]) {
+      drop[j] = 1;
+      ++stats->removed_contradicted[static_cast<int>(map[j].level)];
+    } else if (covered[j] >= options.overlap_share * visible[j] &&
+               InViewShare(map[j], view) >= options.overlap_share) {
+      drop[j] = 1;
+      ++stats->replaced[static_cast<int>(map[j].level)];
+    }
+  }
+  return drop;
+}
+
 }  // namespace
 
 IntegrationStats Integrate(PatchMap* map, const PatchMap& fresh_in, const rig::CameraView& view,
@@ -136,16 +172,8 @@ IntegrationStats Integrate(PatchMap* map, const PatchMap& fresh_in, const rig::C
   stats.offered = static_cast<int>(fresh_in.size());
   cv::Mat old_depth, old_ids, new_depth, new_ids;
   map->Render(view.world_T_camera, view.intrinsics, &old_depth, &old_ids);
-  PatchMap fresh = fresh_in;
-  if (options.fuse) {
-    PatchMap fused;
-    for (const Patch& p : fresh.patches()) {
-      Patch q = p;
-      stats.fused += Fuse(*map, old_ids, view, &q);
-      fused.Add(q);
-    }
-    fresh = std::move(fused);
-  }
+  const PatchMap fresh =
+      options.fuse ? FuseAll(*map, old_ids, view, fresh_in, &stats.fused) : fresh_in;
   fresh.Render(view.world_T_camera, view.intrinsics, &new_depth, &new_ids);
   const size_t n_old = map->size(), n_new = fresh.size();
 
@@ -184,29 +212,15 @@ IntegrationStats Integrate(PatchMap* map, const PatchMap& fresh_in, const rig::C
       ++stats.dropped_contradicted;
     }
   }
-  // Old patches: removed when contradicted, or when kept new patches of their
-  // level or finer cover the overlap share of their visible footprint and
-  // that footprint is the patch (not a sliver of a patch mostly outside the
-  // view, whose rest nothing replaces).
+  // Old patches' visible footprint covered by kept new patches of their
+  // level or finer.
   std::vector<int> covered(n_old, 0);
   for (int y = 0; y < old_ids.rows; ++y)
     for (int x = 0; x < old_ids.cols; ++x) {
       const int n = new_ids.at<int>(y, x), o = old_ids.at<int>(y, x);
       if (o >= 0 && n >= 0 && keep[n] && fresh[n].Fineness() >= (*map)[o].Fineness()) ++covered[o];
     }
-  std::vector<char> drop(n_old, 0);
-  for (size_t j = 0; j < n_old; ++j) {
-    if (visible[j] == 0) continue;
-    if (old_votes[j] > options.contradiction_share * visible[j]) {
-      drop[j] = 1;
-      ++stats.removed_contradicted[static_cast<int>((*map)[j].level)];
-    } else if (covered[j] >= options.overlap_share * visible[j] &&
-               InViewShare((*map)[j], view) >= options.overlap_share) {
-      drop[j] = 1;
-      ++stats.replaced[static_cast<int>((*map)[j].level)];
-    }
-  }
-  map->Remove(drop);
+  map->Remove(OldPatchesToDrop(*map, view, visible, old_votes, covered, options, &stats));
   for (size_t k = 0; k < n_new; ++k)
     if (keep[k]) {
       map->Add(fresh[k]);
