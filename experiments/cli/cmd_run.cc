@@ -241,7 +241,9 @@ void AddRunCommand(CLI::App& app, std::function<int()>* run) {
   cfg->add_option("--config", dump_args->config_path,
                   "YAML configuration to read over the defaults");
   cfg->add_option("--set", dump_args->set, "KEY=VALUE: set one parameter (repeatable)");
-  cfg->callback([dump_args, run] {
+  // The callback holds every value the options write into (as each
+  // command's does), so that they outlive this function.
+  cfg->callback([dump_args, dump, run] {
     *run = [dump_args] {
       std::fputs(DumpConfig(EffectiveConfig(*dump_args)).c_str(), stdout);
       return 0;
