@@ -1,6 +1,7 @@
 // Integration: the hierarchical replacement rule, judged in the current view.
 #include "fovea/integration.h"
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <random>
@@ -242,4 +243,35 @@ TEST_CASE("a patch mostly outside the view is not replaced by what covers its sl
     cover.Add(p);
   }
   CHECK(fovea::Integrate(&inside, cover, view).replaced[0] == 1);
+}
+
+TEST_CASE("IDR patches are retired where finer patches of several fixations cover them",
+          "[fovea][integration]") {
+  const rig::CameraView view = View();
+  fovea::PatchMap map = Grid(10, 0.5, 1.0, fovea::PatchLevel::kIdr);  // 10 cm cells
+  auto square = [](double x0, double z0, double w, double h) {
+    fovea::Patch p;
+    p.corners_W = {Eigen::Vector3d(x0, 1.0, z0), Eigen::Vector3d(x0 + w, 1.0, z0),
+                   Eigen::Vector3d(x0 + w, 1.0, z0 + h), Eigen::Vector3d(x0, 1.0, z0 + h)};
+    p.level = fovea::PatchLevel::kPeripheral;
+    p.resolution_level = 1;
+    return p;
+  };
+  // IDR cell 55 spans x, z in [0, 0.1]: covered by two halves (two fixations'
+  // patches); cell 45 (x in [-0.1, 0]) only on its left half.
+  map.Add(square(0.0, 0.0, 0.1, 0.05));
+  map.Add(square(0.0, 0.05, 0.1, 0.05));
+  map.Add(square(-0.1, 0.0, 0.05, 0.1));
+  const std::vector<char> covered = fovea::CoveredIdrPatches(map, view, 0.9);
+  REQUIRE(covered.size() == map.size());
+  CHECK(std::count(covered.begin(), covered.end(), 1) == 1);
+  CHECK(covered[55] == 1);
+  const std::vector<char> half = fovea::CoveredIdrPatches(map, view, 0.4);
+  CHECK(std::count(half.begin(), half.end(), 1) == 2);
+  CHECK(half[45] == 1);
+  CHECK(std::count(half.begin() + 100, half.end(), 1) == 0);  // finer patches never
+  // Without finer patches nothing is covered.
+  const std::vector<char> none =
+      fovea::CoveredIdrPatches(Grid(10, 0.5, 1.0, fovea::PatchLevel::kIdr), view, 0.0);
+  CHECK(std::count(none.begin(), none.end(), 1) == 0);
 }

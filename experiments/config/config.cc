@@ -307,6 +307,7 @@ void AddDdrParams(RunConfig* c, std::vector<ConfigParam>* params) {
                      {&fp::kIntegrationOverlapShare, &f.integration.overlap_share},
                      {&fp::kIntegrationContradictionShare, &f.integration.contradiction_share},
                      {&fp::kIntegrationFuse, &f.integration.fuse},
+                     {&fp::kIntegrationRetireIdr, &f.integration.retire_idr},
                  });
 }
 

@@ -58,6 +58,7 @@ void AddFixation(const fovea::FixationRecord& r, nlohmann::json* j) {
                          {"replaced_foveal", in.replaced[2]},
                          {"dropped_contradicted", in.dropped_contradicted},
                          {"fused", in.fused},
+                         {"retired_idr", in.retired_idr},
                          {"removed_contradicted_idr", in.removed_contradicted[0]},
                          {"removed_contradicted_peripheral", in.removed_contradicted[1]},
                          {"removed_contradicted_foveal", in.removed_contradicted[2]}};

@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "fovea/geometry.h"
+#include "fovea/integration.h"
 #include "fovea/stats.h"
 
 namespace experiments {
@@ -152,24 +153,8 @@ ReferenceView MakeReferenceView(rig::Rig& rig, const sim::GroundTruth& truth) {
 }
 
 int StaleIdrPatches(const fovea::PatchMap& map, const rig::CameraView& view) {
-  fovea::PatchMap idr, finer;
-  for (const fovea::Patch& p : map.patches())
-    (p.level == fovea::PatchLevel::kIdr ? idr : finer).Add(p);
-  if (idr.size() == 0 || finer.size() == 0) return 0;
-  cv::Mat idr_ids, finer_ids;
-  idr.Render(view.world_T_camera, view.intrinsics, nullptr, &idr_ids);
-  finer.Render(view.world_T_camera, view.intrinsics, nullptr, &finer_ids);
-  std::vector<long> footprint(idr.size(), 0), covered(idr.size(), 0);
-  for (int y = 0; y < idr_ids.rows; ++y)
-    for (int x = 0; x < idr_ids.cols; ++x)
-      if (const int id = idr_ids.at<int>(y, x); id >= 0) {
-        ++footprint[id];
-        covered[id] += finer_ids.at<int>(y, x) >= 0;
-      }
-  int stale = 0;
-  for (size_t i = 0; i < idr.size(); ++i)
-    stale += footprint[i] > 0 && covered[i] >= kStaleCoveredShare * footprint[i];
-  return stale;
+  const std::vector<char> covered = fovea::CoveredIdrPatches(map, view, kStaleCoveredShare);
+  return static_cast<int>(std::count(covered.begin(), covered.end(), 1));
 }
 
 namespace {

@@ -126,6 +126,9 @@ void Absorb(const FixationResult& r, const rig::CameraView& idr_view,
   const auto t = Clock::now();
   state->frame = r.servo.frame;
   rec->integration = Integrate(&run->map, r.foveal.patches, state->frame.left, integration);
+  if (integration.retire_idr)
+    rec->integration.retired_idr = static_cast<int>(
+        run->map.Remove(CoveredIdrPatches(run->map, idr_view, integration.overlap_share)));
   run->map.BuildIndex();
   rec->time.integrate_s = Since(t);
   rec->map_by_level = run->map.CountByLevel();

@@ -229,4 +229,33 @@ IntegrationStats Integrate(PatchMap* map, const PatchMap& fresh_in, const rig::C
   return stats;
 }
 
+std::vector<char> CoveredIdrPatches(const PatchMap& map, const rig::CameraView& view,
+                                    double share) {
+  std::vector<char> covered_idr(map.size(), 0);
+  PatchMap idr, finer;
+  std::vector<size_t> idr_index;  // map index of each IDR patch
+  for (size_t i = 0; i < map.size(); ++i) {
+    if (map[i].level == PatchLevel::kIdr) {
+      idr.Add(map[i]);
+      idr_index.push_back(i);
+    } else {
+      finer.Add(map[i]);
+    }
+  }
+  if (idr.size() == 0 || finer.size() == 0) return covered_idr;
+  cv::Mat idr_ids, finer_ids;
+  idr.Render(view.world_T_camera, view.intrinsics, nullptr, &idr_ids);
+  finer.Render(view.world_T_camera, view.intrinsics, nullptr, &finer_ids);
+  std::vector<long> footprint(idr.size(), 0), covered(idr.size(), 0);
+  for (int y = 0; y < idr_ids.rows; ++y)
+    for (int x = 0; x < idr_ids.cols; ++x)
+      if (const int id = idr_ids.at<int>(y, x); id >= 0) {
+        ++footprint[id];
+        covered[id] += finer_ids.at<int>(y, x) >= 0;
+      }
+  for (size_t k = 0; k < idr.size(); ++k)
+    covered_idr[idr_index[k]] = footprint[k] > 0 && covered[k] >= share * footprint[k];
+  return covered_idr;
+}
+
 }  // namespace fovea

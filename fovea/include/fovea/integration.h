@@ -25,6 +25,11 @@ struct IntegrationOptions {
   /// mean along the viewing ray) with the map's depth there where the map
   /// shows the same surface at the same or a finer level.
   bool fuse = true;
+  /// Beyond the paper: after each fixation, IDR patches whose footprint in
+  /// the IDR view finer patches (of any fixations) cover by overlap_share are
+  /// removed (CoveredIdrPatches). false: an IDR patch goes only when one
+  /// fixation's new patches cover it in that fixation's view.
+  bool retire_idr = true;
   void Check() const;  ///< throws rig::InputError naming the key (fovea/params.h)
 };
 
@@ -35,6 +40,7 @@ struct IntegrationStats {
   int added_outside_view = 0;    ///< new patches with no footprint in the view (added as they are)
   int dropped_contradicted = 0;  ///< new patches dropped: the map contradicts them
   int fused = 0;                 ///< new patches fused with the map's depth
+  int retired_idr = 0;           ///< IDR patches finer data covers in the IDR view (retire_idr)
   std::array<int, 3> replaced{0, 0, 0};              ///< old patches removed, by their PatchLevel
   std::array<int, 3> removed_contradicted{0, 0, 0};  ///< old patches new data contradicts, by level
 };
@@ -51,5 +57,11 @@ struct IntegrationStats {
 /// its work (RunFovea, RunIdr, RunConfig::Check), never per call.
 IntegrationStats Integrate(PatchMap* map, const PatchMap& fresh, const rig::CameraView& view,
                            const IntegrationOptions& options = {});
+
+/// Which of the map's patches (in map order) are IDR patches whose
+/// footprint in `view` (the IDR patches rendered alone) the map's foveal and
+/// peripheral patches cover by `share` or more: the coarse guess adds
+/// nothing there. Two renders, O(N + pixels).
+std::vector<char> CoveredIdrPatches(const PatchMap& map, const rig::CameraView& view, double share);
 
 }  // namespace fovea

@@ -254,6 +254,11 @@ inline constexpr ParamSpec kIntegrationFuse{
     "beyond the paper: fuse a new patch with the map's depth where the map shows the same surface "
     "at the same or a "
     "finer level (inverse-variance mean; false: the paper's replacement only)"};
+inline constexpr ParamSpec kIntegrationRetireIdr{
+    "integration.retire_idr",
+    "beyond the paper: after each fixation, remove the IDR patches whose footprint in the IDR view "
+    "the map's finer patches cover by integration.overlap_share (false: only one fixation's new "
+    "patches replace them)"};
 inline constexpr ParamSpec kLoopFixations{"loop.fixations", "successful fixations to make", 1,
                                           10000};
 inline constexpr ParamSpec kLoopStayInIdrView{
