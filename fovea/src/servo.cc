@@ -43,6 +43,46 @@ double NormalizedL1(const cv::Mat& left, int xl, int yl, const cv::Mat& right, i
 
 namespace {
 
+// Whether the window of half-width `half` about (x, y) has texture to match:
+// its mean absolute deviation from its mean is at least 2 grey levels (the
+// normalized L1 cost against a flat window).
+bool Textured(const cv::Mat& image, int x, int y, int half) {
+  const int n = (2 * half + 1) * (2 * half + 1);
+  double sum = 0;
+  for (int dy = -half; dy <= half; ++dy) {
+    const uchar* row = image.ptr<uchar>(y + dy) + x;
+    for (int dx = -half; dx <= half; ++dx) sum += row[dx];
+  }
+  const double mean = sum / n;
+  double deviation = 0;
+  for (int dy = -half; dy <= half; ++dy) {
+    const uchar* row = image.ptr<uchar>(y + dy) + x;
+    for (int dx = -half; dx <= half; ++dx) deviation += std::abs(row[dx] - mean);
+  }
+  return deviation / n >= 2.0;
+}
+
+// The index of the lowest cost (1e300 = not compared) if it is a match: not
+// at either end of the search nor beside an uncompared position, and with
+// `unique_ratio` < 1 below that share of every other local minimum farther
+// than `half` from it.
+std::optional<int> UniqueMinimum(const std::vector<double>& cost, int half, double unique_ratio) {
+  const int n = static_cast<int>(cost.size());
+  int best = -1;
+  for (int i = 0; i < n; ++i)
+    if (cost[i] < 1e300 && (best < 0 || cost[i] < cost[best])) best = i;
+  if (best <= 0 || best >= n - 1 || cost[best - 1] >= 1e300 || cost[best + 1] >= 1e300)
+    return std::nullopt;
+  if (unique_ratio < 1) {
+    for (int i = 1; i + 1 < n; ++i) {
+      const bool local_min = cost[i] <= cost[i - 1] && cost[i] <= cost[i + 1] && cost[i] < 1e300;
+      if (local_min && std::abs(i - best) > half && cost[best] >= unique_ratio * cost[i])
+        return std::nullopt;
+    }
+  }
+  return best;
+}
+
 // The normalized L1 search of the centre window of `from` (at its rounded
 // principal point) along the same row of `to`, over offsets [lo, hi] pixels
 // from `to`'s principal point; the minimum is refined by a parabola. A
@@ -60,27 +100,17 @@ std::optional<double> SearchRow(const rig::CameraView& from, const rig::CameraVi
   if (xl - h < 0 || yl - h < 0 || xl + h >= l.cols || yl + h >= l.rows || yl + h >= r.rows ||
       hi <= lo)
     return std::nullopt;
-  // No texture in the window: nothing to servo on.
-  if (NormalizedL1(l, xl, yl, cv::Mat(l.size(), CV_8U, cv::Scalar(0)), xl, yl, h) < 2.0)
-    return std::nullopt;
+  if (!Textured(l, xl, yl, h)) return std::nullopt;  // nothing to servo on
   const int n = hi - lo + 1;
   std::vector<double> cost(n, 1e300);
-  int best = -1;
   for (int i = 0; i < n; ++i) {
     const int xr = xr0 + lo + i;
     if (xr - h < 0 || xr + h >= r.cols) continue;
     cost[i] = NormalizedL1(l, xl, yl, r, xr, yl, h);
-    if (best < 0 || cost[i] < cost[best]) best = i;
   }
-  if (best <= 0 || best >= n - 1 || cost[best - 1] >= 1e300 || cost[best + 1] >= 1e300)
-    return std::nullopt;
-  if (unique_ratio < 1) {
-    for (int i = 1; i + 1 < n; ++i) {
-      const bool local_min = cost[i] <= cost[i - 1] && cost[i] <= cost[i + 1] && cost[i] < 1e300;
-      if (local_min && std::abs(i - best) > h && cost[best] >= unique_ratio * cost[i])
-        return std::nullopt;
-    }
-  }
+  const std::optional<int> found = UniqueMinimum(cost, h, unique_ratio);
+  if (!found) return std::nullopt;
+  const int best = *found;
   const double c0 = cost[best - 1], c1 = cost[best], c2 = cost[best + 1];
   const double denom = c0 - 2 * c1 + c2;
   const double sub = denom > 0 ? 0.5 * (c0 - c2) / denom : 0.0;
@@ -143,8 +173,7 @@ bool UniqueAlongRay(const rig::StereoFrame& frame, const Eigen::Vector2d& pixel,
   const int xl = static_cast<int>(std::lround(pixel.x())),
             yl = static_cast<int>(std::lround(pixel.y()));
   if (xl - h < 0 || yl - h < 0 || xl + h >= l.cols || yl + h >= l.rows) return false;
-  if (NormalizedL1(l, xl, yl, cv::Mat(l.size(), CV_8U, cv::Scalar(0)), xl, yl, h) < 2.0)
-    return false;
+  if (!Textured(l, xl, yl, h)) return false;
   // The ray's points by inverse depth, about a pixel apart in the right image.
   const Eigen::Vector3d ray_L = frame.left.intrinsics.Ray(pixel);
   const Eigen::Isometry3d right_T_left =
@@ -159,7 +188,6 @@ bool UniqueAlongRay(const rig::StereoFrame& frame, const Eigen::Vector2d& pixel,
   if (!a || !b) return false;
   const int n = std::clamp(static_cast<int>(std::ceil((*a - *b).norm())) + 1, 3, 2000);
   std::vector<double> cost(n, 1e300);
-  int best = -1;
   for (int i = 0; i < n; ++i) {
     const auto uv = project(w_far + (w_near - w_far) * i / (n - 1));
     if (!uv) continue;
@@ -167,15 +195,8 @@ bool UniqueAlongRay(const rig::StereoFrame& frame, const Eigen::Vector2d& pixel,
               yr = static_cast<int>(std::lround(uv->y()));
     if (xr - h < 0 || yr - h < 0 || xr + h >= r.cols || yr + h >= r.rows) continue;
     cost[i] = NormalizedL1(l, xl, yl, r, xr, yr, h);
-    if (best < 0 || cost[i] < cost[best]) best = i;
   }
-  if (best <= 0 || best >= n - 1 || cost[best - 1] >= 1e300 || cost[best + 1] >= 1e300)
-    return false;
-  for (int i = 1; i + 1 < n; ++i) {
-    const bool local_min = cost[i] <= cost[i - 1] && cost[i] <= cost[i + 1] && cost[i] < 1e300;
-    if (local_min && std::abs(i - best) > h && cost[best] >= o.unique_ratio * cost[i]) return false;
-  }
-  return true;
+  return UniqueMinimum(cost, h, o.unique_ratio).has_value();
 }
 
 ServoResult Servo(rig::Rig& rig, const rig::StageState& start, const ServoOptions& o,
