@@ -143,6 +143,8 @@ expect 2 "--point: expected a number, got 'nan'" fixate --point nan 0.9 0 --out 
 expect 2 "--out: the output path is empty" run --out ''
 expect 2 "--baseline (foveal.baseline_m)" fixate --point 0 0.9 0 --baseline 0 --out "$t/out"
 expect 2 "--matcher (matcher)" fixate --point 0 0.9 0 --matcher census --out "$t/out"
+expect 2 "key 'foveal.rectify': expected true or false" fixate --point 0 0.9 0 --set foveal.rectify=2 --out "$t/out"
+expect 2 "--set expects KEY=VALUE" fixate --point 0 0.9 0 --set foveal.rectify --out "$t/out"
 expect 2 "--fixations (loop.fixations): 0 is out of range" run --fixations 0 --out "$t/out"
 expect 2 "--fixations (loop.fixations): expected a whole number" run --fixations 2.5 --out "$t/out"
 expect 2 "--point: expected a number" bench fixation --point 1e999 0 0

@@ -1,11 +1,14 @@
 // Foveated vergent stereo at one fixation on the simulated rig, noise on,
 // scored against ground truth. Slow: labelled [slow].
 #include <catch2/catch.hpp>
+#include <cmath>
+#include <cstdio>
 
 #include "experiments/config/config.h"
 #include "experiments/scoring/foveal_eval.h"
 #include "fovea/idr.h"
 #include "scenes/catalog.h"
+#include "temp_scene.h"
 
 TEST_CASE("foveal and peripheral depth accuracy at three fixations per scene", "[foveal][slow]") {
   struct Point {
@@ -13,8 +16,9 @@ TEST_CASE("foveal and peripheral depth accuracy at three fixations per scene", "
     Eigen::Vector3d p_W;
   };
   // Cylinder front, left plane, right plane; slanted fabric (two points),
-  // plywood behind. (The wooden blocks, 6 degrees below the rig's horizon at
-  // 0.53 m, get a fovea of a few pixels: see the README's known limitations.)
+  // plywood behind. Foveal depth within 0.15 of the full-resolution step at
+  // these near-level fixations (issue 20: measured 0.064-0.077 in the
+  // fixation frame, 0.062-0.103 unrectified).
   const std::vector<Point> points = {
       {"cylinder_planes", {0.0, 0.89, 0.0}},   {"cylinder_planes", {-0.2, 0.93, 0.05}},
       {"cylinder_planes", {0.25, 1.0, -0.05}}, {"three_surfaces", {0.09, 0.86, 0.05}},
@@ -34,8 +38,7 @@ TEST_CASE("foveal and peripheral depth accuracy at three fixations per scene", "
     INFO("foveal " << s.levels[0].median_error_steps << " steps over " << s.levels[0].patches
                    << " patches, coverage " << s.fovea_coverage);
     REQUIRE(s.levels[0].patches > 0);
-    // Foveal patches: at most a quarter of the full-resolution step.
-    CHECK(s.levels[0].median_error_steps <= 0.25);
+    CHECK(s.levels[0].median_error_steps <= 0.15);
     // Peripheral levels: at most one step of their own level.
     for (size_t k = 1; k < s.levels.size(); ++k)
       if (s.levels[k].patches > 0) CHECK(s.levels[k].median_error_steps <= 1.0);
@@ -81,4 +84,74 @@ TEST_CASE("where the map is silent, a surface outside Z_T gives no false patches
   CHECK(paper.first >= 5);
   CHECK(ours.first * 2 <= paper.first);              // measured 4 against 10
   CHECK(ours.second >= paper.second - paper.first);  // the right patches stay
+}
+
+namespace {
+
+// A photo-textured plane facing the rig's centre from `distance_m` at
+// `elevation_deg` (fronto-parallel to cameras that look there).
+std::string FacingPlane(double distance_m, double elevation_deg) {
+  const double e = elevation_deg * M_PI / 180, c = std::cos(e), s = std::sin(e);
+  const double d = distance_m + 0.005;
+  char geom[300];
+  std::snprintf(geom, sizeof geom,
+                "<geom name=\"plane\" type=\"box\" size=\"0.8 0.6 0.005\" pos=\"0 %.6f %.6f\" "
+                "zaxis=\"0 %.6f %.6f\" material=\"photo\"/>",
+                d * c, d * s, -c, -s);
+  return geom;
+}
+
+struct ElevationFigures {
+  int area = 0, unrectified_area = 0;
+  double error_steps = 0;
+};
+
+ElevationFigures FixateAtElevation(double distance_m, double elevation_deg) {
+  const TempScene scene(FacingPlane(distance_m, elevation_deg), TempScene::PhotoAsset());
+  sim::SimRigConfig config;
+  config.noise.read_noise_sigma_dn = experiments::kExperimentNoiseSigmaDn;
+  auto sim = scenes::LoadScene(scene.path(), config);
+  const double e = elevation_deg * M_PI / 180;
+  const Eigen::Vector3d p_W(0, distance_m * std::cos(e), distance_m * std::sin(e));
+  const fovea::FixationOptions o = fovea::ResolvedFixationOptions({});  // the run's
+  const fovea::Nl1Matcher matcher;
+  const fovea::PatchMap map;  // silent: the fovea is the geometry's alone
+  const fovea::FixationResult r = fovea::Fixate(sim->rig(), map, p_W, matcher, o);
+  REQUIRE(r.ok);
+  ElevationFigures f;
+  f.area = r.foveal.tessellation.rects.at(0).area();
+  f.unrectified_area = fovea::Tessellate(r.servo.frame.left, r.servo.frame.right, r.fixation_W, map,
+                                         o.foveal.tessellation)
+                           .rects.at(0)
+                           .area();
+  const experiments::FovealScore s = experiments::ScoreFoveal(r, sim->truth());
+  REQUIRE(s.levels.at(0).patches > 0);
+  f.error_steps = s.levels[0].median_error_steps;
+  return f;
+}
+
+}  // namespace
+
+TEST_CASE("the fovea keeps its size at any elevation the heads reach", "[foveal][slow]") {
+  // Issue 20: tilted verged heads twist their rows against each other; in
+  // the fixation frame the fovea stays the level fixation's (measured 0.99 to
+  // 1.02 of it, against 0.04-0.17 unrectified beyond 10 degrees), and foveal
+  // depth stays within 0.11 steps. The map is left silent: the fovea is the
+  // geometry's alone (Z_max 0).
+  for (const double distance : {0.6, 0.9, 1.2}) {
+    const ElevationFigures level = FixateAtElevation(distance, 0);
+    for (const int elevation : {-20, -15, -10, 0, 10, 15, 20}) {
+      const ElevationFigures f = elevation == 0 ? level : FixateAtElevation(distance, elevation);
+      std::printf(
+          "plane at %.1f m, elevation %+3d deg: fovea %6d px (%.2f of level), "
+          "unrectified %6d px (%.2f), foveal error %.3f steps\n",
+          distance, elevation, f.area, double(f.area) / level.area, f.unrectified_area,
+          double(f.unrectified_area) / level.area, f.error_steps);
+      INFO("distance " << distance << " elevation " << elevation);
+      CHECK(f.area >= 0.8 * level.area);
+      CHECK(f.area >= 32 * 32);
+      if (std::abs(elevation) <= 15) CHECK(f.error_steps <= 0.25);
+    }
+    CHECK(level.error_steps <= 0.15);
+  }
 }

@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
+#include "fovea/fixation_frame.h"
 #include "fovea/geometry.h"
 #include "fovea/vergence.h"
 
@@ -120,4 +121,134 @@ TEST_CASE("Z_T, Z_max and the depth mask follow the map", "[fovea][tessellation]
   const int u_right = 600, u_left = 40;
   CHECK(t.mask.at<uchar>(240, u_right) == 255);
   CHECK(t.mask.at<uchar>(240, u_left) == 0);
+}
+
+namespace {
+
+// A verged pair of the TAVT's kinematics (optical centres off the pan/tilt
+// axes) fixating p_W, with blank images of the camera's size.
+rig::StereoFrame VergedFrame(const Eigen::Vector3d& p_W, double b) {
+  const Pair pair = Verged(p_W, b);
+  rig::StereoFrame f;
+  f.left = pair.left;
+  f.right = pair.right;
+  for (rig::CameraView* v : {&f.left, &f.right})
+    v->gray = cv::Mat(v->intrinsics.height_px, v->intrinsics.width_px, CV_8U, cv::Scalar(128));
+  return f;
+}
+
+Eigen::Vector3d AtElevation(double distance_m, double elevation_deg) {
+  const double e = elevation_deg * M_PI / 180;
+  return {0.02, distance_m * std::cos(e), distance_m * std::sin(e)};
+}
+
+}  // namespace
+
+TEST_CASE("the fixation frame of a tilted verged pair is a level pair's",
+          "[fovea][tessellation][fixation_frame]") {
+  const double b = 0.12;
+  const rig::StereoFrame tilted = VergedFrame(AtElevation(0.9, 15), b);
+  const fovea::FixationFrame f = fovea::ToFixationFrame(tilted);
+  REQUIRE(f.resampled);
+  // Pan-then-tilt heads twist each image against the other by about
+  // vergence x sin(elevation): a few tenths of a degree each, in opposite senses.
+  CHECK(f.left_roll_rad * f.right_roll_rad < 0);
+  CHECK(std::abs(f.left_roll_rad - f.right_roll_rad) > 0.005);
+  // Axes that meet are already in the plane: only rolls; centres stay.
+  CHECK(std::abs(f.right_turn_rad) < 1e-6);
+  for (auto [a, o] : {std::pair(&f.views.left, &tilted.left), {&f.views.right, &tilted.right}}) {
+    CHECK((a->world_T_camera.translation() - o->world_T_camera.translation()).norm() < 1e-12);
+    CHECK(a->world_T_camera.linear().col(2).isApprox(o->world_T_camera.linear().col(2), 1e-6));
+  }
+  // H maps where a world point appears in the original image to where it
+  // appears in the rolled one.
+  for (const Eigen::Vector3d& p : {Eigen::Vector3d(0.1, 0.95, 0.3), Eigen::Vector3d(-0.2, 0.7, 0.1),
+                                   Eigen::Vector3d(0.05, 1.4, 0.5)}) {
+    for (int side = 0; side < 2; ++side) {
+      const rig::CameraView& o = side ? tilted.right : tilted.left;
+      const rig::CameraView& v = side ? f.views.right : f.views.left;
+      const auto uv = fovea::ProjectWorldPoint(o.world_T_camera, o.intrinsics, p);
+      const auto uv_v = fovea::ProjectWorldPoint(v.world_T_camera, v.intrinsics, p);
+      REQUIRE((uv && uv_v));
+      const cv::Point2d mapped =
+          fovea::MapPixels(side ? f.right_H : f.left_H, {{uv->x(), uv->y()}})[0];
+      CHECK(mapped.x == Approx(uv_v->x()).margin(1e-6));
+      CHECK(mapped.y == Approx(uv_v->y()).margin(1e-6));
+    }
+  }
+  // Both rolled cameras' rows lie in one plane with the baseline: the
+  // fixation point and every point of that plane have no vertical disparity.
+  const Eigen::Vector3d n = f.views.left.world_T_camera.linear().col(1);
+  CHECK(std::abs(n.dot(f.views.right.world_T_camera.linear().col(1))) == Approx(1).margin(1e-6));
+  // The tessellation there is the level fixation's; the original pair's collapses.
+  const rig::StereoFrame level = VergedFrame(AtElevation(0.9, 0.6), b);  // tilt ~0: see below
+  const fovea::FixationFrame level_frame = fovea::ToFixationFrame(level);
+  auto fovea_area = [](const rig::StereoFrame& s, const Eigen::Vector3d& p) {
+    return fovea::Tessellate(s.left, s.right, p, {}, {}).rects.at(0).area();
+  };
+  const int level_area = fovea_area(level_frame.views, AtElevation(0.9, 0.6));
+  const int rolled_area = fovea_area(f.views, AtElevation(0.9, 15));
+  const int original_area = fovea_area(tilted, AtElevation(0.9, 15));
+  INFO("fovea: level " << level_area << " px, tilted 15 deg: " << rolled_area
+                       << " px in the fixation frame, " << original_area << " px unrectified");
+  CHECK(rolled_area >= 0.95 * level_area);
+  CHECK(original_area < 0.3 * level_area);
+}
+
+TEST_CASE("a level verged pair is its own fixation frame",
+          "[fovea][tessellation][fixation_frame]") {
+  // The optical centres sit 1 cm above the tilt axes: a point at that height
+  // needs no tilt, the rows stay in the baseline's plane, nothing is resampled.
+  const rig::StereoFrame level = VergedFrame({0.02, 0.9, 0.01}, 0.12);
+  const fovea::FixationFrame f = fovea::ToFixationFrame(level);
+  CHECK_FALSE(f.resampled);
+  CHECK(f.views.left.gray.data == level.left.gray.data);  // the same images, not copies
+  CHECK(size_t(cv::countNonZero(f.left_valid)) == f.left_valid.total());
+}
+
+TEST_CASE("in the fixation frame the optical axes meet after the right camera pans",
+          "[fovea][tessellation][fixation_frame]") {
+  // The servo pans the tilted right camera about the vertical: its axis
+  // sweeps a cone and passes above or below the left one's, which shifts
+  // every row by a constant. Turned into the fixation frame, points on the
+  // left optical axis at any depth appear on the right image's middle row.
+  rig::StereoFrame tilted = VergedFrame(AtElevation(0.9, 20), 0.12);
+  Eigen::Isometry3d& right = tilted.right.world_T_camera;
+  right.linear() = Eigen::AngleAxisd(2 * M_PI / 180, Eigen::Vector3d::UnitZ()) * right.linear();
+  const fovea::FixationFrame f = fovea::ToFixationFrame(tilted);
+  CHECK(std::abs(f.right_turn_rad) > 5e-4);  // 0.04 degrees out of the plane
+  const auto& k = tilted.left.intrinsics;
+  double original_worst = 0;
+  for (const double z : {0.5, 0.9, 1.5, 5.0}) {
+    const Eigen::Vector3d p_W = tilted.left.world_T_camera * Eigen::Vector3d(0, 0, z);
+    const auto turned =
+        fovea::ProjectWorldPoint(f.views.right.world_T_camera, f.views.right.intrinsics, p_W);
+    const auto original = fovea::ProjectWorldPoint(right, tilted.right.intrinsics, p_W);
+    REQUIRE((turned && original));
+    CHECK(turned->y() == Approx(k.cy_px).margin(1e-6));
+    original_worst = std::max(original_worst, std::abs(original->y() - k.cy_px));
+  }
+  CHECK(original_worst > 2);  // measured 3.8 px
+}
+
+TEST_CASE("the fovea has a floor of foveal.min_fovea_px, and the levels stay nested",
+          "[fovea][tessellation]") {
+  // A tilted verged pair, unrectified: the paper's rule leaves a few pixels.
+  const Eigen::Vector3d fixation = AtElevation(0.6, 20);
+  const Pair pair = Verged(fixation, 0.12);
+  fovea::TessellationOptions paper;
+  paper.min_fovea_px = 0;
+  paper.max_levels = 4;
+  const fovea::Tessellation bare = fovea::Tessellate(pair.left, pair.right, fixation, {}, paper);
+  REQUIRE(bare.rects[0].width < 32);
+  fovea::TessellationOptions floored = paper;
+  floored.min_fovea_px = 32;
+  const fovea::Tessellation t = fovea::Tessellate(pair.left, pair.right, fixation, {}, floored);
+  CHECK(t.rects[0].width == 32);
+  CHECK(t.rects[0].height == 32);
+  const auto& k = pair.left.intrinsics;
+  CHECK(std::abs(t.rects[0].x + 0.5 * t.rects[0].width - k.cx_px) <= 1);  // centred
+  CHECK(std::abs(t.rects[0].y + 0.5 * t.rects[0].height - k.cy_px) <= 1);
+  for (size_t level = 1; level < t.rects.size(); ++level)
+    CHECK((t.rects[level] & t.rects[level - 1]) == t.rects[level - 1]);
 }

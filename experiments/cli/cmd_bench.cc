@@ -124,7 +124,8 @@ WholeFrame MatchWholeFrame(const fovea::FixationResult& r, const fovea::Nl1Match
   auto ms = [](Clock::time_point t0) {
     return 1e3 * std::chrono::duration<double>(Clock::now() - t0).count();
   };
-  const rig::StereoFrame& frame = r.servo.frame;
+  // The frame the fovea matched in: the whole-frame matchers see the same images.
+  const rig::StereoFrame& frame = r.foveal.frame.views;
   const rig::CameraView& left = frame.left;
   const rig::CameraIntrinsics& k = left.intrinsics;
   const fovea::Tessellation& t = r.foveal.tessellation;

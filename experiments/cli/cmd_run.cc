@@ -40,12 +40,7 @@ struct RunArgs {
 
 RunConfig EffectiveConfig(const RunArgs& args) {
   RunConfig c = args.config_path.empty() ? RunConfig{} : LoadConfig(args.config_path);
-  for (const std::string& kv : args.set) {
-    const size_t eq = kv.find('=');
-    if (eq == std::string::npos)
-      throw UsageError("--set expects KEY=VALUE, got '" + rig::ClipForMessage(kv) + "'");
-    SetParam(&c, kv.substr(0, eq), kv.substr(eq + 1));
-  }
+  SetParams(&c, args.set);
   if (!args.scene.empty()) SetParamFromFlag(&c, "--scene", "scene", args.scene);
   if (!args.seed.empty()) SetParamFromFlag(&c, "--seed", "seed", args.seed);
   if (!args.fixations.empty())
@@ -139,6 +134,7 @@ nlohmann::json FoveaSummary(const fovea::FoveaRun& run, const MapScore& score,
   summary["attempts"] = run.records.size();
   summary["refused"] = recorder.refused().size();
   summary["stop_reason"] = run.stop_reason;
+  summary["fovea"] = run_folder::FoveaSizesJson(run.records);
   summary["matcher"] = config.matcher;
   summary["idr"] = {
       {"stages", run.idr.stages.size()},
@@ -205,6 +201,16 @@ int Run(const RunArgs& args) {
   const fovea::StageTimes sum = SumTimes(run.records);
   std::fprintf(stderr, "fovea run: %d fixations (%s): %s -> %s\n", run.fixations_done,
                run.stop_reason.c_str(), ScoreLine(score).c_str(), folder.target().c_str());
+  const nlohmann::json& fovea_sizes = summary["fovea"];
+  if (fovea_sizes["fixations"].get<int>() > 0)
+    std::fprintf(
+        stderr,
+        "fovea run: fovea median %gx%g px (smallest %gx%g), median image share %.3f, %d "
+        "under 32 px\n",
+        fovea_sizes["width_px"]["median"].get<double>(),
+        fovea_sizes["height_px"]["median"].get<double>(),
+        fovea_sizes["width_px"]["min"].get<double>(), fovea_sizes["height_px"]["min"].get<double>(),
+        fovea_sizes["image_share"]["median"].get<double>(), fovea_sizes["under_32px"].get<int>());
   std::fprintf(stderr,
                "fovea run: wall %.1f s: servo (moves, captures) %.1f, IDR %.1f (compute), foveal "
                "stereo %.1f "

@@ -248,6 +248,7 @@ void AddFovealParams(RunConfig* c, std::vector<ConfigParam>* params) {
                      {&fp::kFovealHorizontalDisparityLimitPx,
                       &x.foveal.tessellation.horizontal_disparity_limit_px},
                      {&fp::kFovealMaxLevels, &x.foveal.tessellation.max_levels},
+                     {&fp::kFovealMinFoveaPx, &x.foveal.tessellation.min_fovea_px},
                      {&fp::kFovealFoveaPatchPx, &x.foveal.fovea_patch_px},
                      {&fp::kFovealPeripheryPatchPx, &x.foveal.periphery_patch_px},
                      {&fp::kFovealMapMarginPx, &x.foveal.map_margin_px},
@@ -256,6 +257,7 @@ void AddFovealParams(RunConfig* c, std::vector<ConfigParam>* params) {
                      {&fp::kFovealEdgeJumpPx, &x.foveal.edge_jump_px},
                      {&fp::kFovealMinFillShare, &x.foveal.min_fill_share},
                      {&fp::kFovealMinBlockPx, &x.foveal.min_block_px},
+                     {&fp::kFovealRectify, &x.foveal.rectify},
                      {&fp::kFovealFitMinSupport, &x.foveal.plane_fit.min_support},
                      {&fp::kFovealFitTolerancePx, &x.foveal.plane_fit.fit_tolerance_px},
                      {&fp::kFovealFitMinInlierShare, &x.foveal.plane_fit.min_inlier_share},
@@ -326,6 +328,15 @@ void SetParam(RunConfig* config, const std::string& path, const std::string& val
   for (const ConfigParam& p : ConfigParams(config))
     if (p.path() == path) return Assign(p, value, "key '" + path + "'");
   throw UsageError("unknown key '" + rig::ClipForMessage(path) + "'");
+}
+
+void SetParams(RunConfig* config, const std::vector<std::string>& key_values) {
+  for (const std::string& kv : key_values) {
+    const size_t eq = kv.find('=');
+    if (eq == std::string::npos)
+      throw UsageError("--set expects KEY=VALUE, got '" + rig::ClipForMessage(kv) + "'");
+    SetParam(config, kv.substr(0, eq), kv.substr(eq + 1));
+  }
 }
 
 void SetParamFromFlag(RunConfig* config, const std::string& flag, const std::string& path,

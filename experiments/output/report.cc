@@ -226,6 +226,7 @@ const std::vector<std::pair<std::string, std::string>>& SweepFigures() {
       {"good_coverage", "good coverage"},
       {"edge_bad_share", "bad share near edges"},
       {"foveal_coverage", "foveal coverage"},
+      {"fovea.image_share.median", "fovea's image share (median)"},
       {"median_abs_error_m", "median |depth error|, m"},
       {"median_rel_error", "median relative error"},
       {"rmse_m", "RMSE, m"},
@@ -341,6 +342,9 @@ std::string SceneTable(const std::vector<SweepRow>& rows) {
       {"rmse_m", "RMSE, mm"},
       {"patch_3d_error.p90_m", "patch 3D error p90, mm"},
       {"stale_idr_patches", "stale IDR patches"},
+      {"foveal_coverage", "foveal coverage"},
+      {"fovea.image_share.median", "fovea's image share (median)"},
+      {"fovea.under_32px", "foveas under 32 px"},
       {"refused_share", "refused share of attempts"},
       {"vs_static.fovea_median_abs_error_m", "common pixels: FOVEA median, mm"},
       {"vs_static.static_median_abs_error_m", "common pixels: static median, mm"}};

@@ -1,11 +1,13 @@
 #include "experiments/output/run_folder.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 
 #include "experiments/output/output.h"
 #include "experiments/output/run_output.h"
+#include "fovea/stats.h"
 #include "fovea/timing.h"
 
 namespace experiments::run_folder {
@@ -41,6 +43,14 @@ void AddFixation(const fovea::FixationRecord& r, nlohmann::json* j) {
                           {"z_t_near_m", r.tessellation.z_t_near_m},
                           {"z_t_far_m", r.tessellation.z_t_far_m},
                           {"levels", r.tessellation.rects.size()}};
+  constexpr double kDeg = 180 / M_PI;
+  (*j)["fovea"] = {{"width_px", r.fovea.width_px},
+                   {"height_px", r.fovea.height_px},
+                   {"image_share", r.fovea.image_share},
+                   {"frame", r.resampled ? "fixation" : "original"},
+                   {"left_roll_deg", kDeg * r.left_roll_rad},
+                   {"right_roll_deg", kDeg * r.right_roll_rad},
+                   {"right_turn_deg", kDeg * r.right_turn_rad}};
   nlohmann::json levels = nlohmann::json::array();
   for (const fovea::LevelFigures& l : r.levels)
     levels.push_back({{"level", l.level},
@@ -75,6 +85,33 @@ std::string SnapshotName(int fixation) {
 bool IsWallClockKey(const std::string& key) {
   return key == "wall_time_s" || key == "compute_time_s" || key == "time_s" ||
          key.rfind("time_s.", 0) == 0;
+}
+
+nlohmann::json FoveaSizesJson(const std::vector<fovea::FixationRecord>& records) {
+  std::vector<double> width, height, share;
+  int under_32 = 0, resampled = 0;
+  for (const fovea::FixationRecord& r : records) {
+    if (!r.ok) continue;
+    width.push_back(r.fovea.width_px);
+    height.push_back(r.fovea.height_px);
+    share.push_back(r.fovea.image_share);
+    under_32 += r.fovea.width_px < 32 || r.fovea.height_px < 32;
+    resampled += r.resampled;
+  }
+  const double none = std::nan("");
+  auto figure = [&](double v) { return share.empty() ? nlohmann::json() : nlohmann::json(v); };
+  auto range = [&](const std::vector<double>& v) {
+    return nlohmann::json{{"min", figure(fovea::Quantile(v, 0, none))},
+                          {"median", figure(fovea::Quantile(v, 0.5, none))},
+                          {"max", figure(fovea::Quantile(v, 1, none))}};
+  };
+  nlohmann::json j = {{"fixations", share.size()},  {"width_px", range(width)},
+                      {"height_px", range(height)}, {"image_share", range(share)},
+                      {"under_32px", under_32},     {"in_fixation_frame", resampled}};
+  double sum = 0;
+  for (const double v : share) sum += v;
+  j["image_share"]["mean"] = figure(share.empty() ? none : sum / share.size());
+  return j;
 }
 
 nlohmann::json RecordJson(const fovea::FixationRecord& r, const MapScore& score) {

@@ -10,7 +10,8 @@ using fovea::Quantile;
 
 FovealScore ScoreFoveal(const fovea::FixationResult& r, const sim::GroundTruth& truth) {
   FovealScore score;
-  const rig::StereoFrame& frame = r.servo.frame;
+  // The frame the fovea was matched in: its rects and disparities are there.
+  const rig::StereoFrame& frame = r.foveal.frame.views;
   const rig::CameraView& left = frame.left;
   const rig::CameraIntrinsics& k = left.intrinsics;
   score.baseline_m =
@@ -81,6 +82,18 @@ FovealScore ScoreFoveal(const fovea::FixationResult& r, const sim::GroundTruth& 
   return score;
 }
 
+nlohmann::json FoveaJson(const fovea::FovealResult& f) {
+  const fovea::FoveaSize size = f.Fovea();
+  constexpr double kDeg = 180 / M_PI;
+  return {{"width_px", size.width_px},
+          {"height_px", size.height_px},
+          {"image_share", size.image_share},
+          {"frame", f.frame.resampled ? "fixation" : "original"},
+          {"left_roll_deg", kDeg * f.frame.left_roll_rad},
+          {"right_roll_deg", kDeg * f.frame.right_roll_rad},
+          {"right_turn_deg", kDeg * f.frame.right_turn_rad}};
+}
+
 nlohmann::json FixationJson(const fovea::FixationResult& r, const FovealScore& s) {
   nlohmann::json j;
   j["ok"] = r.ok;
@@ -99,6 +112,7 @@ nlohmann::json FixationJson(const fovea::FixationResult& r, const FovealScore& s
                        {"z_t_far_m", t.z_t_far_m},
                        {"z_max_near_m", t.z_max_near_m},
                        {"z_max_far_m", t.z_max_far_m}};
+  j["fovea"] = FoveaJson(r.foveal);
   nlohmann::json levels = nlohmann::json::array();
   for (size_t i = 0; i < r.foveal.levels.size(); ++i) {
     const auto& f = r.foveal.levels[i];

@@ -240,13 +240,28 @@ int LevelPatches(const rig::StereoFrame& frame, const Tessellation& t, const Lev
 
 }  // namespace
 
-FovealResult FovealStereo(const rig::StereoFrame& frame, const Eigen::Vector3d& fixation_W,
+FoveaSize FovealResult::Fovea() const {
+  FoveaSize f;
+  if (tessellation.rects.empty()) return f;
+  const cv::Rect& r = tessellation.rects[0];
+  f.width_px = r.width;
+  f.height_px = r.height;
+  const cv::Size image = tessellation.mask.size();
+  if (image.area() > 0) f.image_share = double(r.area()) / image.area();
+  return f;
+}
+
+FovealResult FovealStereo(const rig::StereoFrame& captured, const Eigen::Vector3d& fixation_W,
                           const PatchMap& map, const StereoMatcher& matcher,
                           const FovealOptions& options, int fixation) {
   const auto t_start = Clock::now();
   FovealResult result;
+  result.frame = options.rectify ? ToFixationFrame(captured) : OriginalFrame(captured);
+  const rig::StereoFrame& frame = result.frame.views;
   result.tessellation = Tessellate(frame.left, frame.right, fixation_W, map, options.tessellation);
-  const Tessellation& t = result.tessellation;
+  Tessellation& t = result.tessellation;
+  // Pixels turned in from outside the original image are not matched.
+  if (result.frame.resampled) t.mask &= result.frame.left_valid;
   cv::Mat map_depth;
   map.Render(frame.left.world_T_camera, frame.left.intrinsics, &map_depth, nullptr);
   const int levels = static_cast<int>(t.rects.size());
@@ -345,7 +360,9 @@ FixationResult Fixate(rig::Rig& rig, const PatchMap& map, const Eigen::Vector3d&
   std::optional<rig::LeftCameraPair> left_pair;
   if (r.placement == Placement::kLeftPair) left_pair.emplace(rig);
   rig::Rig& pair = left_pair ? static_cast<rig::Rig&>(*left_pair) : rig;
-  r.servo = Servo(pair, r.vergence.state, options.servo, guessed_depths);
+  ServoOptions servo = options.servo;
+  servo.rectify = options.foveal.rectify;
+  r.servo = Servo(pair, r.vergence.state, servo, guessed_depths);
   r.servo_wall_s = Since(t_servo);
   r.motion_time_s = r.servo.motion_time_s;
   // A point refused after servoing: nothing was matched, only the vergence computed.

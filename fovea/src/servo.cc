@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "fovea/fixation_frame.h"
 #include "fovea/geometry.h"
 #include "fovea/params.h"
 
@@ -207,18 +208,22 @@ ServoResult Servo(rig::Rig& rig, const rig::StageState& start, const ServoOption
   for (int step = 0;; ++step) {
     result.frame = rig.Capture();
     result.state = result.frame.state;
+    // Measured in the frame the foveal stereo will match in.
+    const FixationFrame measured =
+        o.rectify ? ToFixationFrame(result.frame) : OriginalFrame(result.frame);
+    const rig::StereoFrame& view = measured.views;
     const int refine =
         std::max(o.refine_px, static_cast<int>(std::ceil(std::abs(result.residual_px) / 4)));
-    const auto d = step > 0       ? CentreDisparity(result.frame, o, refine)
-                   : first_depths ? CentreDisparity(result.frame, o, *first_depths)
-                                  : CentreDisparity(result.frame, o, o.search_px);
+    const auto d = step > 0       ? CentreDisparity(view, o, refine)
+                   : first_depths ? CentreDisparity(view, o, *first_depths)
+                                  : CentreDisparity(view, o, o.search_px);
     if (!d) break;
     result.residual_px = *d;
     result.residuals_px.push_back(*d);
     if (std::abs(*d) < o.tolerance_px) {
       result.converged = true;
       if (o.mutual_tolerance_px > 0) {
-        result.mutual_mismatch_px = MutualMismatch(result.frame, o, *d);
+        result.mutual_mismatch_px = MutualMismatch(view, o, *d);
         result.mutual = result.mutual_mismatch_px &&
                         std::abs(*result.mutual_mismatch_px) < o.mutual_tolerance_px;
         result.converged = result.mutual;

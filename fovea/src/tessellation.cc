@@ -1,5 +1,6 @@
 #include "fovea/tessellation.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -10,6 +11,7 @@ namespace fovea {
 void TessellationOptions::Check() const {
   rig::CheckParam(params::kFovealHorizontalDisparityLimitPx, horizontal_disparity_limit_px);
   rig::CheckParam(params::kFovealMaxLevels, max_levels);
+  rig::CheckParam(params::kFovealMinFoveaPx, min_fovea_px);
 }
 
 int Tessellation::LevelAt(int u, int v) const {
@@ -45,6 +47,26 @@ double AxisHorizontalDisparity(const rig::CameraView& left, const rig::CameraVie
   const Eigen::Vector3d p_R = right.world_T_camera.inverse() * p_W;
   return right.intrinsics.fx_px * p_R.x() / p_R.z();
 }
+
+namespace {
+
+// `r` grown, centred on the principal point, to at least `size` pixels wide
+// and high (within the image).
+cv::Rect AtLeast(const cv::Rect& r, int size, double cx, double cy,
+                 const rig::CameraIntrinsics& k) {
+  cv::Rect out = r;
+  if (r.width < size) {
+    out.x = std::max(0, static_cast<int>(std::lround(cx - 0.5 * size)));
+    out.width = std::min(size, k.width_px - out.x);
+  }
+  if (r.height < size) {
+    out.y = std::max(0, static_cast<int>(std::lround(cy - 0.5 * size)));
+    out.height = std::min(size, k.height_px - out.y);
+  }
+  return out;
+}
+
+}  // namespace
 
 Tessellation Tessellate(const rig::CameraView& left, const rig::CameraView& right,
                         const Eigen::Vector3d& fixation_W, const PatchMap& map,
@@ -112,6 +134,8 @@ Tessellation Tessellate(const rig::CameraView& left, const rig::CameraView& righ
     r.width = std::min(k.width_px - 1, x1) - r.x + 1;
     r.height = std::min(k.height_px - 1, y1) - r.y + 1;
     if (last) r = cv::Rect(0, 0, k.width_px, k.height_px);
+    if (level == 0) r = AtLeast(r, options.min_fovea_px, cx, cy, k);
+    if (level > 0) r |= t.rects.back();  // nested
     t.rects.push_back(r);
     if (last) break;
   }

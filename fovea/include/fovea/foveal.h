@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "fovea/fixation_frame.h"
 #include "fovea/matcher.h"
 #include "fovea/patch.h"
 #include "fovea/placement.h"
@@ -51,6 +52,12 @@ struct FovealOptions {
   /// without data (0: the paper's whole blocks).
   double min_fill_share = 0.5;
   int min_block_px = 4;
+  /// Beyond the paper (issue 20): tessellate, match and triangulate in the
+  /// pair's fixation frame (ToFixationFrame: both cameras turned virtually
+  /// so that the rows of a tilted verged pair no longer twist against each
+  /// other and both optical axes meet); false: the paper's unrectified
+  /// images. The servo follows the same setting (Fixate).
+  bool rectify = true;
   void Check() const;  ///< throws rig::InputError naming the key (fovea/params.h)
 };
 
@@ -65,12 +72,23 @@ struct LevelFigures {
   double match_time_s = 0;
 };
 
+/// The fovea's size at one fixation: level 0's rectangle, in pixels of the
+/// frame it was matched in, and its share of the image.
+struct FoveaSize {
+  int width_px = 0, height_px = 0;
+  double image_share = 0;
+};
+
 struct FovealResult {
+  /// The frame everything below is in (the fixation frame, or the original
+  /// pair when foveal.rectify is off): rects, disparities, the mask.
+  FixationFrame frame;
   Tessellation tessellation;
   std::vector<cv::Mat> disparity_px;  ///< per level, at its resolution (NaN = none)
   std::vector<LevelFigures> levels;
   PatchMap patches;  ///< foveal (level 0) and peripheral patches
   double compute_time_s = 0;
+  FoveaSize Fovea() const;
 };
 
 /// Matches a verged pair that fixates p_W, level by level, coarse to fine,

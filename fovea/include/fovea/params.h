@@ -135,6 +135,13 @@ inline constexpr ParamSpec kFovealHorizontalDisparityLimitPx{
     "the fovea's horizontal disparity limit (sets Z_T), pixels", 2, 256};
 inline constexpr ParamSpec kFovealMaxLevels{"foveal.max_levels",
                                             "resolution levels of the tessellation", 1, 6};
+inline constexpr ParamSpec kFovealMinFoveaPx{
+    "foveal.min_fovea_px",
+    "beyond the paper: the fovea is at least this many pixels wide and high, centred (vertical "
+    "disparity at its edge then stays near half a pixel where the worst-case plane would shrink "
+    "it; "
+    "0 = the paper's rule alone)",
+    0, 256};
 inline constexpr ParamSpec kFovealFoveaPatchPx{"foveal.fovea_patch_px",
                                                "patch size at full resolution, pixels", 4, 64};
 inline constexpr ParamSpec kFovealPeripheryPatchPx{
@@ -166,6 +173,11 @@ inline constexpr ParamSpec kFovealMinFillShare{
     0, 1};
 inline constexpr ParamSpec kFovealMinBlockPx{
     "foveal.min_block_px", "the smallest quarter a block is split into, level pixels", 2, 64};
+inline constexpr ParamSpec kFovealRectify{
+    "foveal.rectify",
+    "beyond the paper: servo, tessellate and match in the pair's fixation frame (both images "
+    "turned so that a tilted verged pair's rows do not twist and the optical axes meet; false = "
+    "the paper's unrectified images)"};
 inline constexpr ParamSpec kFovealFitMinSupport{
     "foveal.fit_min_support",
     "foveal and peripheral patch fit: inlier measurements needed in a block", 3, 4096};

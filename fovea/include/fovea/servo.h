@@ -35,6 +35,10 @@ struct ServoOptions {
   /// otherwise the right camera sees another surface (an occluder, a
   /// repeated texture's copy) and the servo has not converged. 0: no check.
   double mutual_tolerance_px = 4.0;
+  /// Measure in the pair's fixation frame (ToFixationFrame), the frame the
+  /// foveal stereo matches in. Set by Fixate from foveal.rectify, not a
+  /// parameter of its own.
+  bool rectify = true;
   void Check() const;  ///< throws rig::InputError naming the key (fovea/params.h)
 };
 

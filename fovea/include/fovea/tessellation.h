@@ -19,6 +19,12 @@ struct TessellationOptions {
   /// half of it.
   double horizontal_disparity_limit_px = 32;
   int max_levels = 2;  ///< level k samples every 2^k pixels (the paper: 4; see README)
+  /// Beyond the paper: the fovea (level 0) is at least this many pixels wide
+  /// and high, centred, and every coarser level contains it. The worst-case
+  /// plane at Z_max bounds vertical disparity over the whole view; near the
+  /// fixation a surface that far off is rare, and at the floor's edge the
+  /// bound grows only in proportion (the floor's half-size over the rule's).
+  int min_fovea_px = 32;
   void Check() const;  ///< throws rig::InputError naming the key (fovea/params.h)
 };
 

@@ -141,6 +141,10 @@ RunConfig LoadConfig(const std::string& path);
 /// UsageError like LoadConfig.
 void SetParam(RunConfig* config, const std::string& path, const std::string& value);
 
+/// Each "KEY=VALUE" of a repeatable --set flag, in order, through SetParam;
+/// UsageError for an entry without '='.
+void SetParams(RunConfig* config, const std::vector<std::string>& key_values);
+
 /// The same for a command-line flag that sets parameter `path`: the flag's
 /// value is checked against the table like a YAML value, and a message names
 /// the flag ("--sigma (idr.log_sigma_px): 0 is out of range [1, 8]").

@@ -39,6 +39,13 @@ bool IsWallClockKey(const std::string& key);
 /// One attempt's record (a line of fixations.jsonl).
 nlohmann::json RecordJson(const fovea::FixationRecord& record, const MapScore& score);
 
+/// The fovea's size over a run's fixations (summary.json "fovea"): level
+/// 0's width and height (min, median, max), its share of the image (min,
+/// median, mean, max), how many foveas were narrower or shorter than 32 px
+/// and how many were matched in the fixation frame. Sizes are null without a
+/// fixation.
+nlohmann::json FoveaSizesJson(const std::vector<fovea::FixationRecord>& records);
+
 /// What every summary.json holds, FOVEA's and the static baseline's: the
 /// score, the scene, seed and method, the patches by level and the times.
 nlohmann::json SummaryJson(const MapScore& score, const std::string& scene_path,

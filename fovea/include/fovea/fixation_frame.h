@@ -1,0 +1,57 @@
+// The fixation frame of a verged pair (beyond the paper; issue 20): both
+// cameras turned virtually about their optical centres so that their image
+// rows run parallel to the plane through the two optical centres and the
+// left optical axis, and both optical axes lie in it.
+//
+// When the verged cameras also tilt, pan-then-tilt heads twist their image
+// rows against each other (torsion, about vergence x sin(elevation)), the
+// vertical disparity the paper's tessellation reads grows across the image,
+// and the fovea collapses; and a servo that pans the tilted right camera
+// swings its axis off the left one's (a cone, not a plane), which shifts
+// every row by a constant. In this frame the pair is exactly a level vergent
+// pair turned about its baseline: the vertical disparity field, and so the
+// paper's tessellation, Z_T and scanline matching, are those of a level
+// fixation at the same distance and vergence. The left camera only rolls
+// about its principal point; the right one rolls and turns its axis by the
+// (small) angle it missed the plane by. Both keep the fixation at the image
+// centre and the sampling about it (unlike full rectification to a parallel
+// pair, which would also undo the vergence that keeps disparities near zero
+// about the fixation and the search bands narrow).
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include "rig/types.h"
+
+namespace fovea {
+
+struct FixationFrame {
+  /// The pair as matched: rolled images (grey, and BGR when present), rolled
+  /// poses, the original intrinsics and stage state.
+  rig::StereoFrame views;
+  /// Original pixel -> fixation-frame pixel, per camera (the homographies
+  /// of the two rotations).
+  cv::Matx33d left_H = cv::Matx33d::eye(), right_H = cv::Matx33d::eye();
+  double left_roll_rad = 0, right_roll_rad = 0;  ///< about each optical axis, original -> turned
+  double right_turn_rad = 0;                     ///< the right optical axis's angle to the plane
+  /// CV_8U, 255 where a left fixation-frame pixel has its source inside the
+  /// original image (all 255 when not resampled).
+  cv::Mat left_valid;
+  /// false: the turns move no pixel by a hundredth of a pixel and views is
+  /// the original frame, images not resampled.
+  bool resampled = false;
+};
+
+/// The fixation frame of a verged `frame`. Where the turns move no pixel by
+/// a hundredth of a pixel the images are not resampled (a level fixation
+/// matches exactly as before).
+FixationFrame ToFixationFrame(const rig::StereoFrame& frame);
+
+/// The original frame as the frame matched in (the paper's unrectified
+/// matching).
+FixationFrame OriginalFrame(const rig::StereoFrame& frame);
+
+/// Maps pixels through a 3x3 homography.
+std::vector<cv::Point2d> MapPixels(const cv::Matx33d& H, const std::vector<cv::Point2d>& pixels);
+
+}  // namespace fovea

@@ -1,0 +1,114 @@
+#include "fovea/fixation_frame.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+
+namespace fovea {
+namespace {
+
+cv::Matx33d CameraMatrix(const rig::CameraIntrinsics& k) {
+  return {k.fx_px, 0, k.cx_px, 0, k.fy_px, k.cy_px, 0, 0, 1};
+}
+
+// The camera's orientation turned into the plane of unit normal `normal`:
+// its optical axis projected onto the plane, its y axis along the normal
+// (the sign nearest the original y axis). The roll about the optical axis
+// and the axis's turn into the plane, original -> turned.
+Eigen::Matrix3d IntoPlane(const Eigen::Matrix3d& R, const Eigen::Vector3d& normal, double* roll,
+                          double* turn) {
+  *roll = *turn = 0;
+  Eigen::Vector3d z = R.col(2) - normal.dot(R.col(2)) * normal;
+  if (z.norm() < 1e-9) return R;  // the axis lies along the normal: no plane to turn into
+  z.normalize();
+  *turn = std::asin(std::clamp(normal.dot(R.col(2)), -1.0, 1.0));
+  const Eigen::Vector3d y = normal.dot(R.col(1)) < 0 ? Eigen::Vector3d(-normal) : normal;
+  Eigen::Matrix3d out;
+  out.col(0) = y.cross(z);
+  out.col(1) = y;
+  out.col(2) = z;
+  // The turned x axis in the original camera's coordinates.
+  const Eigen::Vector3d x_C = R.transpose() * out.col(0);
+  *roll = std::atan2(x_C.y(), x_C.x());
+  return out;
+}
+
+// The largest angle a rotation turns any vector by, radians.
+double RotationAngle(const Eigen::Matrix3d& R) {
+  return std::acos(std::clamp(0.5 * (R.trace() - 1), -1.0, 1.0));
+}
+
+rig::CameraView TurnView(const rig::CameraView& view, const Eigen::Matrix3d& rolled,
+                         cv::Matx33d* H) {
+  const cv::Matx33d K = CameraMatrix(view.intrinsics);
+  const Eigen::Matrix3d R = rolled.transpose() * view.world_T_camera.linear();
+  cv::Matx33d Rc;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) Rc(i, j) = R(i, j);
+  *H = K * Rc * K.inv();
+  rig::CameraView out;
+  out.intrinsics = view.intrinsics;
+  out.world_T_camera = view.world_T_camera;
+  out.world_T_camera.linear() = rolled;
+  const cv::Size size(view.intrinsics.width_px, view.intrinsics.height_px);
+  cv::warpPerspective(view.gray, out.gray, *H, size, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
+  if (!view.bgr.empty())
+    cv::warpPerspective(view.bgr, out.bgr, *H, size, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
+  return out;
+}
+
+}  // namespace
+
+FixationFrame OriginalFrame(const rig::StereoFrame& frame) {
+  FixationFrame f;
+  f.views = frame;
+  f.left_valid = cv::Mat(frame.left.gray.size(), CV_8U, cv::Scalar(255));
+  return f;
+}
+
+FixationFrame ToFixationFrame(const rig::StereoFrame& frame) {
+  const Eigen::Matrix3d& left = frame.left.world_T_camera.linear();
+  const Eigen::Matrix3d& right = frame.right.world_T_camera.linear();
+  const Eigen::Vector3d baseline =
+      frame.right.world_T_camera.translation() - frame.left.world_T_camera.translation();
+  const Eigen::Vector3d normal = baseline.cross(left.col(2));
+  if (normal.norm() < 1e-12) return OriginalFrame(frame);
+  FixationFrame f;
+  double left_turn = 0;
+  const Eigen::Matrix3d tl = IntoPlane(left, normal.normalized(), &f.left_roll_rad, &left_turn);
+  const Eigen::Matrix3d tr =
+      IntoPlane(right, normal.normalized(), &f.right_roll_rad, &f.right_turn_rad);
+  // Under a hundredth of a pixel at the farthest corner: not worth resampling.
+  const auto& k = frame.left.intrinsics;
+  const double corner =
+      std::hypot(std::max(k.cx_px, k.width_px - k.cx_px), std::max(k.cy_px, k.height_px - k.cy_px));
+  const double angle =
+      std::max(RotationAngle(tl.transpose() * left), RotationAngle(tr.transpose() * right));
+  if (angle * std::max(corner, k.fx_px) < 0.01) {
+    FixationFrame same = OriginalFrame(frame);
+    same.left_roll_rad = f.left_roll_rad;
+    same.right_roll_rad = f.right_roll_rad;
+    same.right_turn_rad = f.right_turn_rad;
+    return same;
+  }
+  f.resampled = true;
+  f.views.state = frame.state;
+  f.views.timestamp_s = frame.timestamp_s;
+  f.views.left = TurnView(frame.left, tl, &f.left_H);
+  f.views.right = TurnView(frame.right, tr, &f.right_H);
+  // Valid where every source pixel of the bilinear sample lies inside.
+  const cv::Mat ones(frame.left.gray.size(), CV_8U, cv::Scalar(255));
+  cv::warpPerspective(ones, f.left_valid, f.left_H, ones.size(), cv::INTER_LINEAR,
+                      cv::BORDER_CONSTANT);
+  f.left_valid = f.left_valid == 255;
+  return f;
+}
+
+std::vector<cv::Point2d> MapPixels(const cv::Matx33d& H, const std::vector<cv::Point2d>& pixels) {
+  std::vector<cv::Point2d> out;
+  cv::perspectiveTransform(pixels, out, cv::Matx33d(H));
+  return out;
+}
+
+}  // namespace fovea
