@@ -1,5 +1,7 @@
 // The full FOVEA run as a user runs it (fovea run): records, summary,
 // reproducibility, local suppression, the paper's near-then-far behaviour.
+#include "fovea/ddr.h"
+
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
@@ -10,6 +12,7 @@
 #include <sstream>
 
 #include "experiments/output/run_folder.h"
+#include "fovea/geometry.h"
 
 namespace fs = std::filesystem;
 namespace run_folder = experiments::run_folder;
@@ -159,4 +162,31 @@ TEST_CASE("local suppression: without it, fixations revisit mapped places more",
   const int with = revisits("true"), without = revisits("false");
   INFO("revisits within 3 cm: with suppression " << with << ", without " << without);
   CHECK(without >= with + 3);
+}
+
+TEST_CASE("a hole's servo search reaches a margin beyond the farthest depth IDR mapped", "[ddr]") {
+  // Two fronto-parallel planes before a camera at the origin looking along
+  // world Y: 1.0 m on the left half of the view, 1.6 m on the right.
+  rig::CameraView view;
+  view.intrinsics = rig::CameraIntrinsics::FromHorizontalFov(160, 120, 30 * M_PI / 180);
+  view.world_T_camera.linear() << 1, 0, 0, 0, 0, 1, 0, -1, 0;  // x right, y down, z = world Y
+  auto plane = [](double x0, double x1, double y) {
+    fovea::Patch p;
+    p.corners_W = {Eigen::Vector3d(x0, y, 1), Eigen::Vector3d(x1, y, 1), Eigen::Vector3d(x1, y, -1),
+                   Eigen::Vector3d(x0, y, -1)};
+    return p;
+  };
+  fovea::PatchMap map;
+  map.Add(plane(-1, 0, 1.0));
+  map.Add(plane(0, 2, 1.6));
+  fovea::FoveaOptions options;
+  options.idr.z_min_m = 0.4;
+  options.hole_far_factor = 1.5;
+  const fovea::DepthRange r = fovea::HoleDepths(map, view, options);
+  CHECK(r.near_m == 0.4);
+  CHECK(r.far_m == Approx(1.5 * 1.6).epsilon(0.01));
+  options.hole_far_factor = 0;  // to infinity, as before
+  CHECK(fovea::HoleDepths(map, view, options).far_m == fovea::kFarDepthM);
+  options.hole_far_factor = 1.5;  // an empty map bounds nothing
+  CHECK(fovea::HoleDepths(fovea::PatchMap(), view, options).far_m == fovea::kFarDepthM);
 }

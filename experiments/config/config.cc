@@ -197,6 +197,7 @@ void AddLoopParams(RunConfig* c, std::vector<ConfigParam>* params) {
                                     {&fp::kLoopStayInIdrView, &f.stay_in_idr_view},
                                     {&fp::kLoopFixateHoles, &f.fixate_holes},
                                     {&fp::kLoopPrescreenHoles, &f.prescreen_holes},
+                                    {&fp::kLoopHoleFarFactor, &f.hole_far_factor},
                                     {&fp::kLoopStallFixations, &f.stall_fixations},
                                     {&fp::kLoopStallGrowth, &f.stall_growth},
                                     {&fp::kLoopAttemptsPerFixation, &f.attempts_per_fixation},

@@ -4,6 +4,7 @@
 
 #include "fovea/geometry.h"
 #include "fovea/params.h"
+#include "fovea/stats.h"
 #include "fovea/timing.h"
 
 namespace fovea {
@@ -34,6 +35,7 @@ void FoveaOptions::Check() const {
   integration.Check();
   rig::CheckParam(params::kLoopFixations, fixations);
   rig::CheckParam(params::kLoopStallFixations, stall_fixations);
+  rig::CheckParam(params::kLoopHoleFarFactor, hole_far_factor);
   rig::CheckParam(params::kLoopStallGrowth, stall_growth);
   rig::CheckParam(params::kLoopAttemptsPerFixation, attempts_per_fixation);
 }
@@ -74,7 +76,7 @@ struct LoopState {
 // kMaxPrescreened times.
 SelectionSummary ChooseTarget(const FoveaRun& run, LoopState& state,
                               const FixationSelector& selector, const FoveaOptions& options,
-                              int attempt, std::mt19937_64* rng) {
+                              const DepthRange& hole_depths, int attempt, std::mt19937_64* rng) {
   if (attempt == 1) {
     SelectionSummary first;
     first.ok = true;
@@ -90,12 +92,11 @@ SelectionSummary ChooseTarget(const FoveaRun& run, LoopState& state,
   context.visits = state.visits;
   if (options.stay_in_idr_view) context.region = run.idr.final_frame.left;
   constexpr int kMaxPrescreened = 8;
-  const DepthRange every_depth{options.idr.z_min_m, kFarDepthM};
   for (int i = 0;; ++i) {
     SelectionSummary s = selector.Choose(context, run.map, state.refused, rng);
     s.prescreened = i;
     if (!s.ok || !s.in_hole || !options.prescreen_holes || i == kMaxPrescreened ||
-        UniqueAlongRay(state.frame, s.pixel, every_depth, options.fixation.servo))
+        UniqueAlongRay(state.frame, s.pixel, hole_depths, options.fixation.servo))
       return s;
     state.refused.push_back(s.point_W);
   }
@@ -153,6 +154,20 @@ bool Stalled(const std::vector<double>& shares, const FoveaOptions& options) {
 
 }  // namespace
 
+DepthRange HoleDepths(const PatchMap& idr_map, const rig::CameraView& idr_view,
+                      const FoveaOptions& options) {
+  DepthRange range{options.idr.z_min_m, kFarDepthM};
+  if (options.hole_far_factor <= 0) return range;
+  cv::Mat depth;
+  idr_map.Render(idr_view.world_T_camera, idr_view.intrinsics, &depth, nullptr);
+  std::vector<double> depths;
+  for (auto it = depth.begin<float>(); it != depth.end<float>(); ++it)
+    if (*it > 0) depths.push_back(*it);
+  if (depths.empty()) return range;
+  range.far_m = std::max(range.near_m, options.hole_far_factor * Quantile(depths, 0.99));
+  return range;
+}
+
 FoveaRun RunFovea(rig::Rig& rig, const StereoMatcher& matcher, const FoveaOptions& options,
                   const FixationObserver& observer) {
   options.Check();  // once: nothing below checks again
@@ -169,6 +184,7 @@ FoveaRun RunFovea(rig::Rig& rig, const StereoMatcher& matcher, const FoveaOption
     return run;
   }
   const rig::CameraView& idr_view = run.idr.final_frame.left;
+  const DepthRange hole_depths = HoleDepths(run.idr.map, idr_view, options);
   LoopState state;
   state.frame = run.idr.final_frame;
   auto record = [&](const FixationRecord& rec) {
@@ -186,7 +202,7 @@ FoveaRun RunFovea(rig::Rig& rig, const StereoMatcher& matcher, const FoveaOption
     FixationRecord rec;
     rec.attempt = attempt;
     auto t = Clock::now();
-    rec.selection = ChooseTarget(run, state, selector, options, attempt, &rng);
+    rec.selection = ChooseTarget(run, state, selector, options, hole_depths, attempt, &rng);
     rec.time.select_s = Since(t);
     if (!rec.selection.ok) {
       rec.why = rec.selection.why;
@@ -196,11 +212,9 @@ FoveaRun RunFovea(rig::Rig& rig, const StereoMatcher& matcher, const FoveaOption
     }
     rec.target_W = rec.selection.point_W;
     // A hole's depth is the nearest mapped depth, a guess: the servo searches
-    // every depth from the nearest the scene allows to infinity.
+    // every depth the scene allows.
     const std::optional<DepthRange> guessed =
-        rec.selection.in_hole
-            ? std::optional<DepthRange>(DepthRange{options.idr.z_min_m, kFarDepthM})
-            : std::nullopt;
+        rec.selection.in_hole ? std::optional<DepthRange>(hole_depths) : std::nullopt;
     const FixationResult r = Fixate(rig, run.map, rec.target_W, matcher, fixation_options,
                                     run.fixations_done + 1, guessed);
     rec.time.verge_s = r.verge_time_s;

@@ -40,6 +40,13 @@ struct FoveaOptions {
   /// (UniqueAlongRay over every depth from idr.z_min_m), it is passed over
   /// without moving the rig, as a refused point would be.
   bool prescreen_holes = true;
+  /// Beyond the paper: a hole's depth is unknown, so its servo search (and
+  /// its prescreen) spans the depths from idr.z_min_m to this factor times
+  /// the farthest depth IDR mapped in its view (the 99th percentile of the
+  /// IDR map's depths there): IDR saw nothing farther anywhere in the view,
+  /// and a match far beyond it is a false one (a texture's copy at a
+  /// disparity of nearly zero). 0: to infinity.
+  double hole_far_factor = 1.5;
   /// Beyond the paper: where the map is silent, the fovea also searches every
   /// depth from idr.z_min_m (the scene's nearest) to infinity and drops Z_T
   /// matches that search contradicts (sets FovealOptions::silent_near_m;
@@ -109,6 +116,12 @@ struct FoveaRun {
   double motion_time_s = 0;  ///< IDR's and every fixation's
   double compute_time_s = 0;
 };
+
+/// The depths a hole's servo search and prescreen span: from idr.z_min_m to
+/// options.hole_far_factor times the 99th percentile of the depths `idr_map`
+/// shows in `idr_view` (to kFarDepthM with factor 0 or an empty map).
+DepthRange HoleDepths(const PatchMap& idr_map, const rig::CameraView& idr_view,
+                      const FoveaOptions& options);
 
 /// Called after every attempt with the record and the map as it stands.
 using FixationObserver = std::function<void(const FixationRecord&, const PatchMap&)>;

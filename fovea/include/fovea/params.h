@@ -284,6 +284,11 @@ inline constexpr ParamSpec kLoopPrescreenHoles{
     "beyond the paper: a hole chosen as the next target whose window has no unique match along its "
     "ray in the "
     "current pair is passed over without moving the rig (false: every hole is attempted)"};
+inline constexpr ParamSpec kLoopHoleFarFactor{
+    "loop.hole_far_factor",
+    "beyond the paper: a hole's servo search and prescreen reach this factor times the farthest "
+    "depth IDR mapped in its view (99th percentile), not infinity (0 = to infinity)",
+    0, 100};
 inline constexpr ParamSpec kLoopStallFixations{"loop.stall_fixations",
                                                "stop when the foveal share grew by less than "
                                                "stall_growth over this many fixations (0 = never)",
