@@ -7,6 +7,7 @@
 
 #include "experiments/output/output.h"
 #include "experiments/output/run_output.h"
+#include "experiments/scoring/foveal_eval.h"
 #include "fovea/stats.h"
 #include "fovea/timing.h"
 
@@ -43,14 +44,7 @@ void AddFixation(const fovea::FixationRecord& r, nlohmann::json* j) {
                           {"z_t_near_m", r.tessellation.z_t_near_m},
                           {"z_t_far_m", r.tessellation.z_t_far_m},
                           {"levels", r.tessellation.rects.size()}};
-  constexpr double kDeg = 180 / M_PI;
-  (*j)["fovea"] = {{"width_px", r.fovea.width_px},
-                   {"height_px", r.fovea.height_px},
-                   {"image_share", r.fovea.image_share},
-                   {"frame", r.resampled ? "fixation" : "original"},
-                   {"left_roll_deg", kDeg * r.left_roll_rad},
-                   {"right_roll_deg", kDeg * r.right_roll_rad},
-                   {"right_turn_deg", kDeg * r.right_turn_rad}};
+  (*j)["fovea"] = FoveaJson(r.fovea);
   nlohmann::json levels = nlohmann::json::array();
   for (const fovea::LevelFigures& l : r.levels)
     levels.push_back({{"level", l.level},
@@ -96,7 +90,7 @@ nlohmann::json FoveaSizesJson(const std::vector<fovea::FixationRecord>& records)
     height.push_back(r.fovea.height_px);
     share.push_back(r.fovea.image_share);
     under_32 += r.fovea.width_px < 32 || r.fovea.height_px < 32;
-    resampled += r.resampled;
+    resampled += r.fovea.resampled;
   }
   const double none = std::nan("");
   auto figure = [&](double v) { return share.empty() ? nlohmann::json() : nlohmann::json(v); };

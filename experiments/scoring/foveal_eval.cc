@@ -82,16 +82,15 @@ FovealScore ScoreFoveal(const fovea::FixationResult& r, const sim::GroundTruth& 
   return score;
 }
 
-nlohmann::json FoveaJson(const fovea::FovealResult& f) {
-  const fovea::FoveaSize size = f.Fovea();
+nlohmann::json FoveaJson(const fovea::FoveaFigures& f) {
   constexpr double kDeg = 180 / M_PI;
-  return {{"width_px", size.width_px},
-          {"height_px", size.height_px},
-          {"image_share", size.image_share},
-          {"frame", f.frame.resampled ? "fixation" : "original"},
-          {"left_roll_deg", kDeg * f.frame.left_roll_rad},
-          {"right_roll_deg", kDeg * f.frame.right_roll_rad},
-          {"right_turn_deg", kDeg * f.frame.right_turn_rad}};
+  return {{"width_px", f.width_px},
+          {"height_px", f.height_px},
+          {"image_share", f.image_share},
+          {"frame", f.resampled ? "fixation" : "original"},
+          {"left_roll_deg", kDeg * f.left_roll_rad},
+          {"right_roll_deg", kDeg * f.right_roll_rad},
+          {"right_turn_deg", kDeg * f.right_turn_rad}};
 }
 
 nlohmann::json FixationJson(const fovea::FixationResult& r, const FovealScore& s) {
@@ -112,7 +111,7 @@ nlohmann::json FixationJson(const fovea::FixationResult& r, const FovealScore& s
                        {"z_t_far_m", t.z_t_far_m},
                        {"z_max_near_m", t.z_max_near_m},
                        {"z_max_far_m", t.z_max_far_m}};
-  j["fovea"] = FoveaJson(r.foveal);
+  j["fovea"] = FoveaJson(r.foveal.Fovea());
   nlohmann::json levels = nlohmann::json::array();
   for (size_t i = 0; i < r.foveal.levels.size(); ++i) {
     const auto& f = r.foveal.levels[i];

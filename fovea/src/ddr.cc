@@ -115,10 +115,6 @@ void RecordFixation(const FixationResult& r, FixationRecord* rec) {
   rec->tessellation.vertical_disparity_px.release();
   rec->tessellation.mask.release();
   rec->fovea = r.foveal.Fovea();
-  rec->resampled = r.foveal.frame.resampled;
-  rec->left_roll_rad = r.foveal.frame.left_roll_rad;
-  rec->right_roll_rad = r.foveal.frame.right_roll_rad;
-  rec->right_turn_rad = r.foveal.frame.right_turn_rad;
   rec->levels = r.foveal.levels;
   rec->time.foveal_s = r.foveal.compute_time_s;
   for (const LevelFigures& l : r.foveal.levels) rec->time.match_s += l.match_time_s;

@@ -240,8 +240,12 @@ int LevelPatches(const rig::StereoFrame& frame, const Tessellation& t, const Lev
 
 }  // namespace
 
-FoveaSize FovealResult::Fovea() const {
-  FoveaSize f;
+FoveaFigures FovealResult::Fovea() const {
+  FoveaFigures f;
+  f.resampled = frame.resampled;
+  f.left_roll_rad = frame.left_roll_rad;
+  f.right_roll_rad = frame.right_roll_rad;
+  f.right_turn_rad = frame.right_turn_rad;
   if (tessellation.rects.empty()) return f;
   const cv::Rect& r = tessellation.rects[0];
   f.width_px = r.width;
@@ -251,12 +255,12 @@ FoveaSize FovealResult::Fovea() const {
   return f;
 }
 
-FovealResult FovealStereo(const rig::StereoFrame& captured, const Eigen::Vector3d& fixation_W,
+FovealResult FovealStereo(const FixationFrame& matched, const Eigen::Vector3d& fixation_W,
                           const PatchMap& map, const StereoMatcher& matcher,
                           const FovealOptions& options, int fixation) {
   const auto t_start = Clock::now();
   FovealResult result;
-  result.frame = options.rectify ? ToFixationFrame(captured) : OriginalFrame(captured);
+  result.frame = matched;
   const rig::StereoFrame& frame = result.frame.views;
   result.tessellation = Tessellate(frame.left, frame.right, fixation_W, map, options.tessellation);
   Tessellation& t = result.tessellation;
@@ -392,7 +396,8 @@ FixationResult Fixate(rig::Rig& rig, const PatchMap& map, const Eigen::Vector3d&
   if (options.map_check)
     if (const auto why = DisagreesWithMap(frame, r.fixation_W, depth, r.servo.residual_px, map))
       return refuse(*why);
-  r.foveal = FovealStereo(frame, r.fixation_W, map, matcher, options.foveal, fixation);
+  // In the frame the servo measured in (foveal.rectify), not turned again.
+  r.foveal = FovealStereo(r.servo.measured, r.fixation_W, map, matcher, options.foveal, fixation);
   r.compute_time_s = verge_s + r.foveal.compute_time_s;
   r.ok = true;
   return r;

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "fovea/fixation_frame.h"
 #include "fovea/geometry.h"
 #include "fovea/params.h"
 
@@ -209,9 +208,8 @@ ServoResult Servo(rig::Rig& rig, const rig::StageState& start, const ServoOption
     result.frame = rig.Capture();
     result.state = result.frame.state;
     // Measured in the frame the foveal stereo will match in.
-    const FixationFrame measured =
-        o.rectify ? ToFixationFrame(result.frame) : OriginalFrame(result.frame);
-    const rig::StereoFrame& view = measured.views;
+    result.measured = o.rectify ? ToFixationFrame(result.frame) : OriginalFrame(result.frame);
+    const rig::StereoFrame& view = result.measured.views;
     const int refine =
         std::max(o.refine_px, static_cast<int>(std::ceil(std::abs(result.residual_px) / 4)));
     const auto d = step > 0       ? CentreDisparity(view, o, refine)

@@ -96,9 +96,7 @@ struct FixationRecord {
   double servo_residual_px = 0;
   bool servo_converged = false;
   Tessellation tessellation;  ///< without its images (cleared)
-  FoveaSize fovea;            ///< level 0's rectangle, in the frame matched in
-  bool resampled = false;     ///< matched in a resampled fixation frame (FixationFrame)
-  double left_roll_rad = 0, right_roll_rad = 0, right_turn_rad = 0;
+  FoveaFigures fovea;         ///< level 0's rectangle, in the frame matched in, and its turns
   std::vector<LevelFigures> levels;
   IntegrationStats integration;
   std::array<int, 3> map_by_level{0, 0, 0};

@@ -56,7 +56,8 @@ struct FovealOptions {
   /// pair's fixation frame (ToFixationFrame: both cameras turned virtually
   /// so that the rows of a tilted verged pair no longer twist against each
   /// other and both optical axes meet); false: the paper's unrectified
-  /// images. The servo follows the same setting (Fixate).
+  /// images. Fixate hands it to the servo (ServoOptions::rectify), which
+  /// measures in that frame and passes it on (ServoResult::measured).
   bool rectify = true;
   void Check() const;  ///< throws rig::InputError naming the key (fovea/params.h)
 };
@@ -72,11 +73,14 @@ struct LevelFigures {
   double match_time_s = 0;
 };
 
-/// The fovea's size at one fixation: level 0's rectangle, in pixels of the
-/// frame it was matched in, and its share of the image.
-struct FoveaSize {
+/// The fovea at one fixation: level 0's rectangle, in pixels of the frame
+/// it was matched in, its share of the image, and that frame's turns
+/// (FixationFrame).
+struct FoveaFigures {
   int width_px = 0, height_px = 0;
   double image_share = 0;
+  bool resampled = false;  ///< matched in a resampled fixation frame
+  double left_roll_rad = 0, right_roll_rad = 0, right_turn_rad = 0;
 };
 
 struct FovealResult {
@@ -88,15 +92,17 @@ struct FovealResult {
   std::vector<LevelFigures> levels;
   PatchMap patches;  ///< foveal (level 0) and peripheral patches
   double compute_time_s = 0;
-  FoveaSize Fovea() const;
+  FoveaFigures Fovea() const;
 };
 
 /// Matches a verged pair that fixates p_W, level by level, coarse to fine,
 /// with the range at each pixel bounded by `map` (or by Z_T where the map is
-/// silent), and fits patches: `fixation` is recorded in each patch.
+/// silent), and fits patches: `fixation` is recorded in each patch. `frame`
+/// is the pair as it is matched (ToFixationFrame, or OriginalFrame with
+/// foveal.rectify off): the servo's ServoResult::measured.
 /// `options` must have passed Check(): the run checks them once, before
 /// its work (RunFovea, RunIdr, RunConfig::Check), never per call.
-FovealResult FovealStereo(const rig::StereoFrame& frame, const Eigen::Vector3d& fixation_W,
+FovealResult FovealStereo(const FixationFrame& frame, const Eigen::Vector3d& fixation_W,
                           const PatchMap& map, const StereoMatcher& matcher,
                           const FovealOptions& options, int fixation = 0);
 

@@ -7,6 +7,7 @@
 #include <optional>
 #include <vector>
 
+#include "fovea/fixation_frame.h"
 #include "rig/rig.h"
 
 namespace fovea {
@@ -93,6 +94,9 @@ struct ServoResult {
   std::vector<double> residuals_px;  ///< one per measurement
   rig::StageState state;             ///< where the rig ended
   rig::StereoFrame frame;            ///< the last pair captured
+  /// That pair as measured (ToFixationFrame with options.rectify, else
+  /// OriginalFrame): the frame the foveal stereo matches in.
+  FixationFrame measured;
   double motion_time_s = 0;
 };
 

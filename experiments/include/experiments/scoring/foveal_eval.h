@@ -29,4 +29,8 @@ FovealScore ScoreFoveal(const fovea::FixationResult& result, const sim::GroundTr
 
 nlohmann::json FixationJson(const fovea::FixationResult& result, const FovealScore& score);
 
+/// The fovea's figures as a record's and fixate.json's "fovea" object
+/// (angles in degrees).
+nlohmann::json FoveaJson(const fovea::FoveaFigures& fovea);
+
 }  // namespace experiments
