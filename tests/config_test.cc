@@ -143,7 +143,7 @@ TEST_CASE("every parameter of the table: both ends pass, just outside is refused
   }
   CHECK(numbers > 70);
   CHECK(flags > 10);
-  CHECK(choices == 3);
+  CHECK(choices == 4);  // method, matcher, rig type, nl1.cost
 }
 
 TEST_CASE("the options' own Check() names the YAML key and uses the table's range", "[config]") {

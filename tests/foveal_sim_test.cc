@@ -53,7 +53,7 @@ TEST_CASE("where the map is silent, a surface outside Z_T gives no false patches
   // takes false matches of their grain for surfaces in the band.
   sim::SimRigConfig config;
   config.noise.read_noise_sigma_dn = experiments::kExperimentNoiseSigmaDn;
-  auto gross = [&](double silent_near_m) {
+  auto gross = [&](double silent_near_m, const std::string& cost) {
     auto sim = scenes::LoadScene("three_surfaces", config);
     fovea::FixationOptions o = fovea::ResolvedFixationOptions({});  // the run's
     o.baseline_m = 0.12;         // Z_T about -0.15 / +0.2 m around 1.2 m: the blocks far outside it
@@ -63,7 +63,9 @@ TEST_CASE("where the map is silent, a surface outside Z_T gives no false patches
     // levels neither setting gives the fovea a patch off by over 5%.
     o.foveal.tessellation.max_levels = 4;
     o.foveal.silent_near_m = silent_near_m;
-    const fovea::Nl1Matcher matcher;
+    fovea::Nl1Options nl1;
+    nl1.cost = cost;
+    const fovea::Nl1Matcher matcher(nl1);
     const Eigen::Vector3d plywood(-0.25, 1.2, 0.1);
     const fovea::FixationResult r =
         fovea::Fixate(sim->rig(), fovea::PatchMap(), plywood, matcher, o);
@@ -77,13 +79,23 @@ TEST_CASE("where the map is silent, a surface outside Z_T gives no false patches
     }
     return std::make_pair(n, patches);
   };
-  const auto paper = gross(0.0), ours = gross(0.4);
-  INFO("patches off by over 5%: paper's band " << paper.first << " of " << paper.second
-                                               << ", wider check " << ours.first << " of "
-                                               << ours.second);
-  CHECK(paper.first >= 5);
-  CHECK(ours.first * 2 <= paper.first);              // measured 4 against 10
-  CHECK(ours.second >= paper.second - paper.first);  // the right patches stay
+  // The paper's cost (window_mean) takes the blocks' grain for surfaces in
+  // the band; the wider search, once per fixation at quarter resolution,
+  // removes some (measured 13 -> 9 of 190). The pre-normalized cost, less
+  // each image's mean over twice the window, keeps more of the texture's
+  // low frequencies out of reach of a copy: its band search alone gives 4,
+  // and the check leaves them (they are not copies of the blocks).
+  const auto paper = gross(0.0, "window_mean"), paper_checked = gross(0.4, "window_mean");
+  const auto ours = gross(0.0, "prenormalized"), ours_checked = gross(0.4, "prenormalized");
+  INFO("patches off by over 5%, window_mean: band " << paper.first << " of " << paper.second
+                                                    << ", checked " << paper_checked.first);
+  INFO("prenormalized: band " << ours.first << " of " << ours.second << ", checked "
+                              << ours_checked.first);
+  CHECK(paper.first >= 10);
+  CHECK(paper_checked.first * 4 <= paper.first * 3);
+  CHECK(ours.first * 2 <= paper.first);
+  CHECK(ours_checked.first <= ours.first);
+  CHECK(ours_checked.second >= ours.second - ours.first);  // the right patches stay
 }
 
 namespace {

@@ -103,3 +103,181 @@ TEST_CASE("SGBM plugs into the same interface and finds the same disparity", "[f
     CHECK(sgbm.Name() == "sgbm");
   }
 }
+
+namespace {
+// The matcher's rules written plainly, pixel by pixel and disparity by
+// disparity, as an oracle for the cost volume's strips, column ranges and
+// vectorized winners: texture test, band [floor(lo) - 1, ceil(hi) + 1]
+// within the image, winner-take-all with its minimum inside the band, the
+// matched right pixel's winner among the left pixels whose bands reach it
+// (left-right check), equiangular sub-pixel (the right pixel's from its
+// neighbouring candidates), the two views' estimates averaged.
+struct Reference {
+  cv::Mat disparity;
+  int searched = 0, matched = 0, texture = 0;
+};
+
+Reference MatchPlainly(const cv::Mat& left, const cv::Mat& right, const cv::Mat& lo,
+                       const cv::Mat& hi, const fovea::Nl1Options& o) {
+  const int h = o.window_half_px, n = 2 * h + 1, cols = left.cols;
+  const float inf = std::numeric_limits<float>::infinity();
+  cv::Mat ml, fl, fr, wl, wr;
+  cv::boxFilter(left, ml, CV_32F, cv::Size(n, n));
+  left.convertTo(fl, CV_32F);
+  right.convertTo(fr, CV_32F);
+  // Pre-normalized: less the mean over twice the window.
+  cv::boxFilter(fl, wl, CV_32F, cv::Size(2 * n + 1, 2 * n + 1));
+  cv::boxFilter(fr, wr, CV_32F, cv::Size(2 * n + 1, 2 * n + 1));
+  const cv::Mat a = fl - wl, b = fr - wr;
+  auto cost = [&](int x, int y, int d) {
+    const int xr = x - d;
+    if (x - h < 0 || x + h >= cols || xr - h < 0 || xr + h >= cols) return inf;
+    float c = 0;
+    for (int dy = -h; dy <= h; ++dy)
+      for (int dx = -h; dx <= h; ++dx)
+        c += std::abs(a.at<float>(y + dy, x + dx) - b.at<float>(y + dy, xr + dx));
+    return c / (n * n);
+  };
+  auto sub = [](double c0, double c1, double c2) {
+    const double s = std::max(c0 - c1, c2 - c1);
+    return s > 0 ? std::clamp(0.5 * (c0 - c2) / s, -0.5, 0.5) : 0.0;
+  };
+  Reference r;
+  r.disparity = cv::Mat(left.size(), CV_32F, cv::Scalar(std::nanf("")));
+  cv::Mat blo(left.size(), CV_32S, cv::Scalar(1)), bhi(left.size(), CV_32S, cv::Scalar(0));
+  for (int y = h; y < left.rows - h; ++y)
+    for (int x = h; x < cols - h; ++x) {
+      if (!(lo.at<float>(y, x) <= hi.at<float>(y, x))) continue;
+      ++r.searched;
+      float mad = 0;
+      for (int dy = -h; dy <= h; ++dy)
+        for (int dx = -h; dx <= h; ++dx)
+          mad += std::abs(fl.at<float>(y + dy, x + dx) - ml.at<float>(y, x));
+      if (mad < o.min_texture_dn * n * n) {
+        ++r.texture;
+        continue;
+      }
+      const float dmin = x - (cols - 1 - h), dmax = x - h;
+      blo.at<int>(y, x) =
+          static_cast<int>(std::clamp(std::floor(lo.at<float>(y, x)) - 1, dmin - 1, dmax + 1));
+      bhi.at<int>(y, x) =
+          static_cast<int>(std::clamp(std::ceil(hi.at<float>(y, x)) + 1, dmin - 1, dmax + 1));
+    }
+  for (int y = h; y < left.rows - h; ++y)
+    for (int x = h; x < cols - h; ++x) {
+      const int l = blo.at<int>(y, x), u = bhi.at<int>(y, x);
+      if (l > u) continue;
+      int d = l;
+      float best = inf;
+      for (int dd = l; dd <= u; ++dd)
+        if (cost(x, y, dd) < best) {
+          best = cost(x, y, dd);
+          d = dd;
+        }
+      if (!std::isfinite(best) || d == l || d == u) continue;
+      const float c0 = cost(x, y, d - 1), c2 = cost(x, y, d + 1);
+      if (!std::isfinite(c0) || !std::isfinite(c2)) continue;
+      const double left_d = d + sub(c0, best, c2);
+      const int xr = x - d;
+      int dr = 0;
+      float rbest = inf;
+      for (int xx = h; xx < cols - h; ++xx) {
+        const int dd = xx - xr;
+        if (dd < blo.at<int>(y, xx) || dd > bhi.at<int>(y, xx)) continue;
+        const float c = cost(xx, y, dd);
+        if (c < rbest || (c == rbest && dd < dr)) {
+          rbest = c;
+          dr = dd;
+        }
+      }
+      if (!std::isfinite(rbest)) continue;
+      // The neighbours among the candidates: left pixels whose bands hold them.
+      auto candidate = [&](int xl, int dl) {
+        return xl >= 0 && xl < cols && blo.at<int>(y, xl) <= dl && dl <= bhi.at<int>(y, xl)
+                   ? cost(xl, y, dl)
+                   : inf;
+      };
+      const float r0 = candidate(xr + dr - 1, dr - 1), r2 = candidate(xr + dr + 1, dr + 1);
+      const bool refined = std::isfinite(r0) && std::isfinite(r2);
+      const double right_d = dr + (refined ? sub(r0, rbest, r2) : 0.0);
+      if (std::abs(right_d - left_d) > o.lr_tolerance_px) continue;
+      r.disparity.at<float>(y, x) = static_cast<float>(refined ? 0.5 * (left_d + right_d) : left_d);
+      ++r.matched;
+    }
+  return r;
+}
+}  // namespace
+
+TEST_CASE("the cost-volume matcher gives what its rules give, pixel by pixel", "[fovea][matcher]") {
+  const cv::Mat left = Texture(72, 150, 21);
+  // A disparity that grows across the image (a slanted surface), and bands
+  // that vary per pixel: narrow about a map's prediction, wide where it is
+  // silent, absurd where a ray grazes the right camera, none here and there.
+  cv::Mat right(left.size(), CV_8U);
+  cv::Mat map_x(left.size(), CV_32F), map_y(left.size(), CV_32F);
+  for (int y = 0; y < left.rows; ++y)
+    for (int x = 0; x < left.cols; ++x) {
+      map_x.at<float>(y, x) = static_cast<float>(x + (2.0 + 0.03 * x));
+      map_y.at<float>(y, x) = static_cast<float>(y);
+    }
+  cv::remap(left, right, map_x, map_y, cv::INTER_CUBIC, cv::BORDER_REFLECT);
+  cv::RNG rng(4);
+  cv::Mat lo(left.size(), CV_32F), hi(left.size(), CV_32F);
+  // Layouts: mixed bands; or two bands far apart in each row (the left
+  // half's near the truth, the right half's 20 px off), whose hull holds
+  // disparities no pixel searches.
+  const int layout = GENERATE(0, 1);
+  INFO("layout " << layout);
+  for (int y = 0; y < left.rows; ++y)
+    for (int x = 0; x < left.cols; ++x) {
+      // right(x) = left(x + 2 + 0.03 x): d = x_left - x_right.
+      const double truth = (2.0 + 0.03 * x) / 1.03;
+      double l = truth - rng.uniform(1.0, 3.0), u = truth + rng.uniform(1.0, 3.0);
+      if (layout == 1 && x >= left.cols / 2) l += 20, u += 20;
+      const int kind = layout == 0 ? rng.uniform(0, 20) : -1;
+      if (kind == 0) l = truth - 25, u = truth + 15;  // silent: wide
+      if (kind == 1) l = -1e30, u = 1e30;             // grazing ray
+      if (kind == 2) l = 1, u = 0;                    // not searched
+      if (kind == 3) l = truth + 40, u = truth + 60;  // beside the image
+      lo.at<float>(y, x) = static_cast<float>(l);
+      hi.at<float>(y, x) = static_cast<float>(u);
+    }
+  const fovea::Nl1Options options;
+  const Reference ref = MatchPlainly(left, right, lo, hi, options);
+  const fovea::DisparityMap fast = fovea::Nl1Matcher(options).Match(left, right, lo, hi);
+  CHECK(fast.searched == ref.searched);
+  CHECK(fast.rejected_texture == ref.texture);
+  REQUIRE(ref.matched > (layout == 0 ? 0.5 : 0.3) * ref.searched);
+  // Box sums run down the strip in floating point: a tie between two
+  // disparities may break differently, nothing more.
+  int disagree = 0;
+  for (int y = 0; y < left.rows; ++y)
+    for (int x = 0; x < left.cols; ++x) {
+      const float f = fast.disparity_px.at<float>(y, x), r = ref.disparity.at<float>(y, x);
+      if (std::isfinite(f) != std::isfinite(r) || (std::isfinite(f) && std::abs(f - r) > 1e-3))
+        ++disagree;
+    }
+  CHECK(disagree <= ref.matched / 1000);
+  CHECK(std::abs(fast.matched - ref.matched) <= ref.matched / 1000);
+}
+
+TEST_CASE("NL1 with the paper's window-mean cost matches as well as the pre-normalized one",
+          "[fovea][matcher]") {
+  const cv::Mat left = Texture(80, 120, 13);
+  const cv::Mat right = Shift(left, 4.4);
+  const cv::Mat lo(left.size(), CV_32F, cv::Scalar(0)), hi(left.size(), CV_32F, cv::Scalar(8));
+  fovea::Nl1Options paper;
+  paper.cost = "window_mean";
+  for (const auto& options : {fovea::Nl1Options{}, paper}) {
+    INFO("cost " << options.cost);
+    const auto r = fovea::Nl1Matcher(options).Match(left, right, lo, hi);
+    std::vector<double> errs;
+    for (int y = 5; y < 75; ++y)
+      for (int x = 20; x < 110; ++x)
+        if (std::isfinite(r.disparity_px.at<float>(y, x)))
+          errs.push_back(std::abs(r.disparity_px.at<float>(y, x) - 4.4));
+    REQUIRE(errs.size() > 0.95 * 70 * 90);
+    std::nth_element(errs.begin(), errs.begin() + errs.size() / 2, errs.end());
+    CHECK(errs[errs.size() / 2] < 0.1);
+  }
+}

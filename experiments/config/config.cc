@@ -271,6 +271,7 @@ void AddFovealParams(RunConfig* c, std::vector<ConfigParam>* params) {
                      {&fp::kFovealServoUniqueRatio, &x.servo.unique_ratio},
                      {&fp::kFovealServoMutualPx, &x.servo.mutual_tolerance_px},
                      {&fp::kFovealSilentConfidence, &x.foveal.silent_confidence},
+                     {&fp::kFovealSilentCheckLevel, &x.foveal.silent_check_level},
                      {&fp::kFovealServoMaxSteps, &x.servo.max_steps},
                  });
 }
@@ -285,6 +286,7 @@ void AddDdrParams(RunConfig* c, std::vector<ConfigParam>* params) {
                      {&fp::kNl1WindowHalfPx, &f.nl1.window_half_px},
                      {&fp::kNl1MinTextureDn, &f.nl1.min_texture_dn},
                      {&fp::kNl1LrTolerancePx, &f.nl1.lr_tolerance_px},
+                     {&fp::kNl1Cost, &f.nl1.cost},
                      {&fp::kSgbmBlockSize, &f.sgbm.block_size},
                      {&fp::kSgbmUniquenessRatio, &f.sgbm.uniqueness_ratio},
                      {&fp::kSgbmSpeckleWindow, &f.sgbm.speckle_window},

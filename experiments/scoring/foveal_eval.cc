@@ -17,8 +17,9 @@ FovealScore ScoreFoveal(const fovea::FixationResult& r, const sim::GroundTruth& 
   score.baseline_m =
       (frame.right.world_T_camera.translation() - left.world_T_camera.translation()).norm();
   const double b = score.baseline_m;
-  cv::Mat ids;
-  const cv::Mat depth = truth.RayCastDepth(left.world_T_camera, k, &ids);
+  const sim::GroundTruth::Labels labels = truth.RenderLabels(left.world_T_camera, k);
+  const cv::Mat& depth = labels.depth_m;
+  const cv::Mat& ids = labels.geom_ids;
   const Eigen::Isometry3d right_T_left = frame.right.world_T_camera.inverse() * left.world_T_camera;
   const fovea::Tessellation& t = r.foveal.tessellation;
   const int levels = static_cast<int>(t.rects.size());

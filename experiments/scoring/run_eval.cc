@@ -95,7 +95,10 @@ ReferenceView MakeReferenceView(rig::Rig& rig, const sim::GroundTruth& truth) {
   ReferenceView ref;
   rig.MoveTo(rig.Home());
   ref.view = rig.Capture().left;
-  ref.depth_m = truth.RayCastDepth(ref.view.world_T_camera, ref.view.intrinsics, &ref.geom_ids);
+  sim::GroundTruth::Labels labels =
+      truth.RenderLabels(ref.view.world_T_camera, ref.view.intrinsics);
+  ref.depth_m = labels.depth_m;
+  ref.geom_ids = labels.geom_ids;
   ref.textured = truth.TexturedMask(ref.geom_ids);
   ref.textured_pixels = cv::countNonZero(ref.textured);
   ref.near_edge = NearEdge(ref.depth_m);

@@ -20,6 +20,7 @@ void FovealOptions::Check() const {
   rig::CheckParam(params::kFovealMapMarginPx, map_margin_px);
   rig::CheckParam(params::kFovealCoarseMarginPx, coarse_margin_px);
   rig::CheckParam(params::kFovealSilentConfidence, silent_confidence);
+  rig::CheckParam(params::kFovealSilentCheckLevel, silent_check_level);
   rig::CheckParam(params::kFovealEdgeErosionPx, edge_erosion_px);
   rig::CheckParam(params::kFovealEdgeJumpPx, edge_jump_px);
   rig::CheckParam(params::kFovealMinFillShare, min_fill_share);
@@ -49,12 +50,15 @@ struct Level {
   cv::Rect rect;  ///< full-resolution pixels it covers
 };
 
-Level MakeLevel(const rig::StereoFrame& frame, const Tessellation& t, int index) {
+// Level `index` of the tessellation; `octave` (default: the level's own)
+// sets the resolution, 2^octave full-resolution pixels per pixel.
+Level MakeLevel(const rig::StereoFrame& frame, const Tessellation& t, int index, int octave = -1) {
   Level l;
   l.index = index;
-  l.scale = std::pow(2.0, index);
+  if (octave < 0) octave = index;
+  l.scale = std::pow(2.0, octave);
   l.rect = t.rects[index];
-  if (index == 0) {
+  if (octave == 0) {
     l.left = frame.left.gray;
     l.right = frame.right.gray;
   } else {
@@ -64,30 +68,71 @@ Level MakeLevel(const rig::StereoFrame& frame, const Tessellation& t, int index)
   return l;
 }
 
+// The pixels of a level with `scale` full-resolution pixels per pixel whose
+// centres ((x + 0.5) scale - 0.5) may round into `rect`, one spare each side.
+cv::Rect LevelPixels(const cv::Rect& rect, double scale) {
+  const int x0 = static_cast<int>(std::floor((rect.x + 0.5) / scale - 0.5)) - 1;
+  const int y0 = static_cast<int>(std::floor((rect.y + 0.5) / scale - 0.5)) - 1;
+  const int x1 = static_cast<int>(std::ceil((rect.br().x + 0.5) / scale - 0.5)) + 1;
+  const int y1 = static_cast<int>(std::ceil((rect.br().y + 0.5) / scale - 0.5)) + 1;
+  return {x0, y0, x1 - x0, y1 - y0};
+}
+
+// Disparities of one left pixel at planar depths z, in a level's pixels:
+// its ray is found once (CameraIntrinsics::Ray), each depth then costs a few
+// multiplications (DisparityAtDepth's arithmetic, unrolled).
+class PixelDisparity {
+ public:
+  PixelDisparity(const rig::StereoFrame& frame, double scale)
+      : left_(frame.left.intrinsics),
+        fx_r_(frame.right.intrinsics.fx_px),
+        cx_r_(frame.right.intrinsics.cx_px),
+        scale_(scale) {
+    const Eigen::Isometry3d right_T_left =
+        frame.right.world_T_camera.inverse() * frame.left.world_T_camera;
+    r_ = right_T_left.linear();
+    t_ = right_T_left.translation();
+  }
+  void At(double u, double v) {
+    u_ = u;
+    rr_ = r_ * left_.Ray({u, v});
+  }
+  /// NaN behind the right camera.
+  double operator()(double z) const {
+    const double zr = z * rr_.z() + t_.z();
+    if (zr <= 1e-6) return std::numeric_limits<double>::quiet_NaN();
+    return (u_ - (fx_r_ * (z * rr_.x() + t_.x()) / zr + cx_r_)) / scale_;
+  }
+
+ private:
+  const rig::CameraIntrinsics& left_;
+  double fx_r_, cx_r_, scale_;
+  Eigen::Matrix3d r_;
+  Eigen::Vector3d t_, rr_;
+  double u_ = 0;
+};
+
 // Per-pixel disparity ranges of one level (lo > hi: not searched): around the
 // coarser level's estimate, else around the map's prediction, else (the map
-// silent) the Z_T band about the fixation depth; `wide` gets, where the map
-// is silent, the range from silent_near_m to infinity as well.
+// silent) the Z_T band about the fixation depth, marked in `silent`.
 struct SearchRanges {
-  cv::Mat lo, hi, wide_lo, wide_hi;
+  cv::Mat lo, hi;
+  cv::Mat silent;  ///< CV_8U: the Z_T band, the map silent and no coarser estimate
 };
 
 SearchRanges LevelRanges(const rig::StereoFrame& frame, const Tessellation& t,
                          const cv::Mat& map_depth, const cv::Mat* coarse, const Level& level,
                          const FovealOptions& options) {
-  const rig::CameraView& left = frame.left;
-  const rig::CameraView& right = frame.right;
-  const rig::CameraIntrinsics& k = left.intrinsics;
-  const Eigen::Isometry3d right_T_left = right.world_T_camera.inverse() * left.world_T_camera;
+  const rig::CameraIntrinsics& k = frame.left.intrinsics;
   const double s = level.scale, z0 = t.fixation_depth_m;
-  auto disparity = [&](double u, double v, double z) {
-    return DisparityAtDepth(left, right, right_T_left, u, v, z) / s;
-  };
+  PixelDisparity disparity(frame, s);
   const cv::Size size = level.left.size();
   SearchRanges r{cv::Mat(size, CV_32F, cv::Scalar(1)), cv::Mat(size, CV_32F, cv::Scalar(0)),
-                 cv::Mat(size, CV_32F, cv::Scalar(1)), cv::Mat(size, CV_32F, cv::Scalar(0))};
-  for (int y = 0; y < size.height; ++y)
-    for (int x = 0; x < size.width; ++x) {
+                 cv::Mat(size, CV_8U, cv::Scalar(0))};
+  // The level's pixels whose centres may fall in its rectangle.
+  const cv::Rect inside = LevelPixels(level.rect, s) & cv::Rect(cv::Point(), size);
+  for (int y = inside.y; y < inside.br().y; ++y)
+    for (int x = inside.x; x < inside.br().x; ++x) {
       const double u = (x + 0.5) * s - 0.5, v = (y + 0.5) * s - 0.5;
       const int ui = std::clamp(static_cast<int>(std::lround(u)), 0, k.width_px - 1);
       const int vi = std::clamp(static_cast<int>(std::lround(v)), 0, k.height_px - 1);
@@ -102,21 +147,17 @@ SearchRanges LevelRanges(const rig::StereoFrame& frame, const Tessellation& t,
         dlo = 2 * cd - options.coarse_margin_px;
         dhi = 2 * cd + options.coarse_margin_px;
       } else if (z > 0) {
-        const double d = disparity(u, v, z);
+        disparity.At(u, v);
+        const double d = disparity(z);
         dlo = d - options.map_margin_px;
         dhi = d + options.map_margin_px;
       } else {
         // The map is silent: anything within Z_T of the fixation depth.
-        const double a = disparity(u, v, z0 - t.z_t_near_m), b = disparity(u, v, z0 + t.z_t_far_m);
+        disparity.At(u, v);
+        const double a = disparity(z0 - t.z_t_near_m), b = disparity(z0 + t.z_t_far_m);
         dlo = std::min(a, b) - 1;
         dhi = std::max(a, b) + 1;
-        if (options.silent_near_m > 0) {
-          const double n = disparity(u, v, options.silent_near_m), f = disparity(u, v, kFarDepthM);
-          if (std::isfinite(n) && std::isfinite(f)) {
-            r.wide_lo.at<float>(y, x) = static_cast<float>(std::min({dlo, n, f}));
-            r.wide_hi.at<float>(y, x) = static_cast<float>(std::max({dhi, n, f}));
-          }
-        }
+        r.silent.at<uchar>(y, x) = 1;
       }
       if (!std::isfinite(dlo) || !std::isfinite(dhi)) continue;
       r.lo.at<float>(y, x) = static_cast<float>(dlo);
@@ -125,28 +166,72 @@ SearchRanges LevelRanges(const rig::StereoFrame& frame, const Tessellation& t,
   return r;
 }
 
-// A band match where the wide search (every depth from silent_near_m)
-// confidently matched outside Z_T is a false match of a surface the band
-// does not hold: dropped from `dm`. Returns how many.
-int DropOutsideBand(const Level& level, const StereoMatcher& matcher, SearchRanges& ranges,
+// The wide search behind FovealOptions::silent_near_m, once per fixation
+// at one coarse resolution (2^silent_check_level full-resolution pixels
+// per pixel): every pixel the map is silent at, over every depth from
+// silent_near_m to infinity and the Z_T band.
+struct SilentCheck {
+  double scale = 1;  ///< full-resolution pixels per pixel
+  cv::Mat wide;      ///< disparity, its pixels (NaN: none); empty: no check
+  cv::Mat confidence;
+};
+
+SilentCheck CheckSilent(const rig::StereoFrame& frame, const Tessellation& t,
+                        const cv::Mat& map_depth, const StereoMatcher& matcher,
+                        const FovealOptions& options) {
+  SilentCheck c;
+  c.scale = std::pow(2.0, options.silent_check_level);
+  const Level level = MakeLevel(frame, t, 0, options.silent_check_level);
+  const rig::CameraIntrinsics& k = frame.left.intrinsics;
+  const double s = c.scale, z0 = t.fixation_depth_m;
+  PixelDisparity disparity(frame, s);
+  const cv::Size size = level.left.size();
+  cv::Mat lo(size, CV_32F, cv::Scalar(1)), hi(size, CV_32F, cv::Scalar(0));
+  const cv::Rect& outer = t.rects.back();
+  for (int y = 0; y < size.height; ++y)
+    for (int x = 0; x < size.width; ++x) {
+      const double u = (x + 0.5) * s - 0.5, v = (y + 0.5) * s - 0.5;
+      const int ui = std::clamp(static_cast<int>(std::lround(u)), 0, k.width_px - 1);
+      const int vi = std::clamp(static_cast<int>(std::lround(v)), 0, k.height_px - 1);
+      if (!outer.contains({ui, vi}) || t.mask.at<uchar>(vi, ui) == 0 ||
+          map_depth.at<float>(vi, ui) > 0)
+        continue;
+      disparity.At(u, v);
+      const double values[4] = {disparity(z0 - t.z_t_near_m), disparity(z0 + t.z_t_far_m),
+                                disparity(options.silent_near_m), disparity(kFarDepthM)};
+      if (!std::all_of(std::begin(values), std::end(values),
+                       [](double d) { return std::isfinite(d); }))
+        continue;
+      lo.at<float>(y, x) =
+          static_cast<float>(*std::min_element(std::begin(values), std::end(values)) - 1);
+      hi.at<float>(y, x) =
+          static_cast<float>(*std::max_element(std::begin(values), std::end(values)) + 1);
+    }
+  const DisparityMap dm = matcher.Match(level.left, level.right, lo, hi);
+  c.wide = dm.disparity_px;
+  c.confidence = dm.confidence;
+  return c;
+}
+
+// A band match at a silent pixel where the wide search (CheckSilent)
+// confidently matched outside the band (give or take one of its pixels) is
+// a false match of a surface the band does not hold: dropped from `dm`.
+// Returns how many.
+int DropOutsideBand(const SilentCheck& check, const Level& level, const SearchRanges& ranges,
                     const FovealOptions& options, DisparityMap* dm) {
-  // Only where the band matched is there anything to drop.
-  for (int y = 0; y < dm->disparity_px.rows; ++y)
-    for (int x = 0; x < dm->disparity_px.cols; ++x)
-      if (!std::isfinite(dm->disparity_px.at<float>(y, x))) {
-        ranges.wide_lo.at<float>(y, x) = 1;  // lo > hi: not searched
-        ranges.wide_hi.at<float>(y, x) = 0;
-      }
-  const DisparityMap wide = matcher.Match(level.left, level.right, ranges.wide_lo, ranges.wide_hi);
+  const double ratio = check.scale / level.scale;  // this level's pixels per check pixel
   int dropped = 0;
   for (int y = 0; y < dm->disparity_px.rows; ++y)
     for (int x = 0; x < dm->disparity_px.cols; ++x) {
       float& d = dm->disparity_px.at<float>(y, x);
-      const float w = wide.disparity_px.at<float>(y, x);
-      if (!std::isfinite(d) || !std::isfinite(w) ||
-          wide.confidence.at<float>(y, x) < options.silent_confidence)
+      if (!std::isfinite(d) || !ranges.silent.at<uchar>(y, x)) continue;
+      const int xc = std::min(check.wide.cols - 1, static_cast<int>((x + 0.5) / ratio));
+      const int yc = std::min(check.wide.rows - 1, static_cast<int>((y + 0.5) / ratio));
+      const float w = check.wide.at<float>(yc, xc);
+      if (!std::isfinite(w) || check.confidence.at<float>(yc, xc) < options.silent_confidence)
         continue;
-      if (w < ranges.lo.at<float>(y, x) - 1 || w > ranges.hi.at<float>(y, x) + 1) {
+      const double wl = w * ratio;
+      if (wl < ranges.lo.at<float>(y, x) - ratio || wl > ranges.hi.at<float>(y, x) + ratio) {
         d = std::numeric_limits<float>::quiet_NaN();
         ++dropped;
       }
@@ -269,6 +354,12 @@ FovealResult FovealStereo(const FixationFrame& matched, const Eigen::Vector3d& f
   cv::Mat map_depth;
   map.Render(frame.left.world_T_camera, frame.left.intrinsics, &map_depth, nullptr);
   const int levels = static_cast<int>(t.rects.size());
+  SilentCheck silent;
+  if (options.silent_near_m > 0 && levels > 0) {
+    const auto t0 = Clock::now();
+    silent = CheckSilent(frame, t, map_depth, matcher, options);
+    result.silent_check_time_s = Since(t0);
+  }
   result.disparity_px.resize(levels);
   result.levels.resize(levels);
   // Coarse to fine: each level's search starts from the coarser one's estimate.
@@ -279,7 +370,7 @@ FovealResult FovealStereo(const FixationFrame& matched, const Eigen::Vector3d& f
     SearchRanges ranges = LevelRanges(frame, t, map_depth, coarse, level, options);
     DisparityMap dm = matcher.Match(level.left, level.right, ranges.lo, ranges.hi);
     const int outside_band =
-        options.silent_near_m > 0 ? DropOutsideBand(level, matcher, ranges, options, &dm) : 0;
+        silent.wide.empty() ? 0 : DropOutsideBand(silent, level, ranges, options, &dm);
 
     LevelFigures& fig = result.levels[index];
     fig.level = index;

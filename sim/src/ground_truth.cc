@@ -7,8 +7,15 @@
 
 namespace sim {
 
-TrueView GroundTruth::Render(const Eigen::Isometry3d& world_T_camera,
-                             const rig::CameraIntrinsics& k, bool color) const {
+bool GroundTruth::Renderable(const rig::CameraIntrinsics& k) const {
+  return k.distortion.empty() && std::abs(k.fx_px - k.fy_px) <= 1e-9 * k.fx_px &&
+         std::abs(k.cx_px - 0.5 * (k.width_px - 1)) <= 1e-9 &&
+         std::abs(k.cy_px - 0.5 * (k.height_px - 1)) <= 1e-9 && k.width_px <= world_->width_px &&
+         k.height_px <= world_->height_px;
+}
+
+void GroundTruth::PlaceTruthCamera(const Eigen::Isometry3d& world_T_camera,
+                                   const rig::CameraIntrinsics& k) const {
   k.Check();
   const mjModel* m = world_->m;
   if (!k.distortion.empty() || std::abs(k.fx_px - k.fy_px) > 1e-9 * k.fx_px ||
@@ -32,13 +39,72 @@ TrueView GroundTruth::Render(const Eigen::Isometry3d& world_T_camera,
   world_->m->cam_quat[4 * id + 3] = q.z();
   world_->m->cam_fovy[id] = k.VerticalFovRad() * 180 / M_PI;
   mj_camlight(world_->m, world_->d);
+}
 
+TrueView GroundTruth::Render(const Eigen::Isometry3d& world_T_camera,
+                             const rig::CameraIntrinsics& k, bool color) const {
+  PlaceTruthCamera(world_T_camera, k);
   TrueView view;
   cv::Mat rgb;
-  world_->renderer->Render(world_->m, world_->d, id, k.width_px, k.height_px,
+  world_->renderer->Render(world_->m, world_->d, world_->truth_camera_id, k.width_px, k.height_px,
                            color ? &rgb : nullptr, &view.depth_m);
   if (color) cv::cvtColor(rgb, view.bgr, cv::COLOR_RGB2BGR);
   return view;
+}
+
+GroundTruth::Labels GroundTruth::RenderLabels(const Eigen::Isometry3d& world_T_camera,
+                                              const rig::CameraIntrinsics& k) const {
+  k.Check();
+  if (!Renderable(k)) {
+    Labels l;
+    l.depth_m = RayCastDepth(world_T_camera, k, &l.geom_ids);
+    l.ray_cast = k.width_px * k.height_px;
+    return l;
+  }
+  PlaceTruthCamera(world_T_camera, k);
+  World& w = *world_;
+  if (!w.truth_renderer)
+    w.truth_renderer = new OffscreenRenderer(w.m, w.width_px, w.height_px, /*truth=*/true);
+  Labels l;
+  w.truth_renderer->RenderLabels(w.m, w.d, w.truth_camera_id, k.width_px, k.height_px, &l.depth_m,
+                                 &l.geom_ids);
+  // Where the raster may not be the exact geometry: faceted builtin
+  // shapes, and both sides of every edge between surfaces.
+  const mjModel* m = w.m;
+  auto faceted = [m](int g) {
+    if (g < 0) return false;
+    const int type = m->geom_type[g];
+    return type == mjGEOM_SPHERE || type == mjGEOM_CAPSULE || type == mjGEOM_ELLIPSOID ||
+           type == mjGEOM_CYLINDER;
+  };
+  constexpr double kJumpShare = 0.01;  // a depth step of 1% between neighbours is an edge
+  cv::Mat exact(k.height_px, k.width_px, CV_8U, cv::Scalar(0));
+  for (int v = 0; v < k.height_px; ++v)
+    for (int u = 0; u < k.width_px; ++u) {
+      const int g = l.geom_ids.at<int>(v, u);
+      const float z = l.depth_m.at<float>(v, u);
+      bool edge = faceted(g);
+      for (int dv = -1; dv <= 1 && !edge; ++dv)
+        for (int du = -1; du <= 1 && !edge; ++du) {
+          const int vv = v + dv, uu = u + du;
+          if (vv < 0 || uu < 0 || vv >= k.height_px || uu >= k.width_px) continue;
+          const int gn = l.geom_ids.at<int>(vv, uu);
+          const float zn = l.depth_m.at<float>(vv, uu);
+          edge = gn != g || faceted(gn) || std::abs(zn - z) > kJumpShare * std::max(z, zn);
+        }
+      if (edge) exact.at<uchar>(v, u) = 1;
+    }
+  const Eigen::Vector3d origin = world_T_camera.translation();
+  for (int v = 0; v < k.height_px; ++v)
+    for (int u = 0; u < k.width_px; ++u) {
+      if (!exact.at<uchar>(v, u)) continue;
+      const Eigen::Vector3d ray_C = k.Ray({u, v});
+      const auto hit = CastRay(origin, world_T_camera.linear() * ray_C);
+      l.depth_m.at<float>(v, u) = hit ? static_cast<float>(hit->distance_m / ray_C.norm()) : 0.0f;
+      l.geom_ids.at<int>(v, u) = hit ? hit->geom_id : -1;
+      ++l.ray_cast;
+    }
+  return l;
 }
 
 std::optional<RayHit> GroundTruth::CastRay(const Eigen::Vector3d& p_W,
@@ -51,6 +117,21 @@ std::optional<RayHit> GroundTruth::CastRay(const Eigen::Vector3d& p_W,
                              world_->visible_groups.data(), 1, -1, &geom);
   if (dist < 0 || geom < 0) return std::nullopt;
   return RayHit{dist, geom, p_W + dist * u};
+}
+
+std::optional<double> GroundTruth::CastRayAt(int geom_id, const Eigen::Vector3d& p_W,
+                                             const Eigen::Vector3d& dir_W) const {
+  const mjModel* m = world_->m;
+  const double norm = dir_W.norm();
+  if (geom_id < 0 || geom_id >= m->ngeom || !(norm > 0)) return std::nullopt;
+  const Eigen::Vector3d u = dir_W / norm;
+  const double dist =
+      m->geom_type[geom_id] == mjGEOM_MESH
+          ? mj_rayMesh(m, world_->d, geom_id, p_W.data(), u.data())
+          : mju_rayGeom(world_->d->geom_xpos + 3 * geom_id, world_->d->geom_xmat + 9 * geom_id,
+                        m->geom_size + 3 * geom_id, p_W.data(), u.data(), m->geom_type[geom_id]);
+  if (dist < 0) return std::nullopt;
+  return dist;
 }
 
 cv::Mat GroundTruth::RayCastDepth(const Eigen::Isometry3d& world_T_camera,

@@ -19,7 +19,10 @@ namespace sim {
 /// model camera into the offscreen buffer; no display and no GPU needed.
 class OffscreenRenderer {
  public:
-  OffscreenRenderer(const mjModel* m, int width_px, int height_px);
+  /// `truth`: a renderer for ground truth, not for the cameras: no
+  /// multisampling (an edge pixel shows one surface, not a blend) and the
+  /// builtin curved geoms drawn with finer facets.
+  OffscreenRenderer(mjModel* m, int width_px, int height_px, bool truth = false);
   ~OffscreenRenderer();
   OffscreenRenderer(const OffscreenRenderer&) = delete;
   OffscreenRenderer& operator=(const OffscreenRenderer&) = delete;
@@ -29,6 +32,11 @@ class OffscreenRenderer {
   /// where the far plane was hit). Either may be null.
   void Render(const mjModel* m, mjData* d, int cam_id, int width_px, int height_px, cv::Mat* rgb,
               cv::Mat* depth_m);
+
+  /// Renders depth and, per pixel, the geom shown (CV_32SC1, -1: none) by
+  /// MuJoCo's segmentation rendering (mjRND_SEGMENT, mjRND_IDCOLOR).
+  void RenderLabels(const mjModel* m, mjData* d, int cam_id, int width_px, int height_px,
+                    cv::Mat* depth_m, cv::Mat* geom_ids);
 
  private:
   OSMesaContext context_ = nullptr;
@@ -47,8 +55,10 @@ struct World {
   std::array<int, rig::kNumAxes> actuator_ids{};  // ordered as rig::Axis
   std::array<int, 2> camera_ids{};                // left, right
   int truth_camera_id = -1;
-  std::vector<unsigned char> visible_groups;  // mj_ray filter: groups 0-2
-  OffscreenRenderer* renderer = nullptr;      // owned
+  std::vector<unsigned char> visible_groups;    // mj_ray filter: groups 0-2
+  OffscreenRenderer* renderer = nullptr;        // owned
+  OffscreenRenderer* truth_renderer = nullptr;  // owned; made on first use (GroundTruth)
+  int width_px = 0, height_px = 0;              // the rig's images
 
   ~World();
 };

@@ -40,6 +40,11 @@ struct FovealOptions {
   /// 0: the paper's band search only.
   double silent_near_m = 0;
   double silent_confidence = 0.2;
+  /// The wide search runs once per fixation, at 2^silent_check_level
+  /// full-resolution pixels per pixel, over every pixel the map is silent
+  /// at (its cost grows with the depth range in pixels: at full resolution
+  /// it would cost more than all the levels' band searches together).
+  int silent_check_level = 2;
   /// Beyond the paper: pixels within this many level pixels of a pixel whose
   /// disparity is more than edge_jump_px smaller are dropped before the
   /// patches are fitted (window matching fattens a nearer surface over a
@@ -92,6 +97,7 @@ struct FovealResult {
   std::vector<LevelFigures> levels;
   PatchMap patches;  ///< foveal (level 0) and peripheral patches
   double compute_time_s = 0;
+  double silent_check_time_s = 0;  ///< the wide search (FovealOptions::silent_near_m)
   FoveaFigures Fovea() const;
 };
 

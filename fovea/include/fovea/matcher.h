@@ -29,13 +29,21 @@ struct Nl1Options {
   int window_half_px = 3;        ///< a 7 x 7 window
   double min_texture_dn = 2.0;   ///< mean absolute deviation of the left window
   double lr_tolerance_px = 1.0;  ///< left-right check
-  void Check() const;            ///< throws rig::InputError naming the key (fovea/params.h)
+  /// "prenormalized" or "window_mean" (params::kNl1Cost).
+  std::string cost = "prenormalized";
+  void Check() const;  ///< throws rig::InputError naming the key (fovea/params.h)
 };
 
-/// Normalized L1 window matching (the paper's cost: sum |(L - mean L) - (R -
-/// mean R)|), winner-take-all, parabola sub-pixel refinement, left-right
-/// consistency check; confidence from the margin between the best and the
-/// second-best non-adjacent cost.
+/// Normalized L1 window matching, winner-take-all, parabola sub-pixel
+/// refinement, left-right consistency check; confidence from the margin
+/// between the best and the second-best non-adjacent cost. The cost is the
+/// mean absolute difference of mean-free windows: by default each image less
+/// its local mean over twice the window (pre-normalized, so that window sums
+/// run), or the
+/// paper's sum |(L - mean L) - (R - mean R)| with the means of the two
+/// windows compared (Nl1Options::cost). Costs are computed per tile of the
+/// level over the union of its pixels' bands, once for both directions of
+/// the left-right check (the right pixel's costs are the left pixels').
 class Nl1Matcher : public StereoMatcher {
  public:
   explicit Nl1Matcher(const Nl1Options& options = {});
@@ -44,6 +52,10 @@ class Nl1Matcher : public StereoMatcher {
   std::string Name() const override { return "nl1"; }
 
  private:
+  /// Match on a crop that holds every searched pixel with its window and
+  /// the right columns its band reaches.
+  DisparityMap MatchCrop(const cv::Mat& left, const cv::Mat& right, const cv::Mat& lo_px,
+                         const cv::Mat& hi_px) const;
   Nl1Options options_;
 };
 

@@ -153,6 +153,11 @@ inline constexpr ParamSpec kFovealMapMarginPx{
 inline constexpr ParamSpec kFovealCoarseMarginPx{
     "foveal.coarse_margin_px", "and +- this many level pixels around the coarser level's estimate",
     0.1, 32};
+inline constexpr ParamSpec kFovealSilentCheckLevel{
+    "foveal.silent_check_level",
+    "see foveal.silent_check: the wide search runs once per fixation at this resolution level "
+    "(2^level full-resolution pixels per pixel)",
+    0, 4};
 inline constexpr ParamSpec kFovealSilentConfidence{
     "foveal.silent_confidence",
     "see foveal.silent_check: the wider search's match confidence needed to drop a band match", 0,
@@ -202,6 +207,14 @@ inline constexpr ParamSpec kNl1MinTextureDn{
     50};
 inline constexpr ParamSpec kNl1LrTolerancePx{"nl1.lr_tolerance_px",
                                              "NL1: left-right check tolerance, pixels", 0.01, 10};
+inline constexpr const char* kNl1Costs[] = {"prenormalized", "window_mean", nullptr};
+inline constexpr ParamSpec kNl1Cost{
+    "nl1.cost",
+    "NL1 cost: prenormalized (each image less its local mean over twice the window, then the "
+    "window's mean absolute "
+    "difference, box-summed: O(1) per pixel and disparity) or window_mean (the paper's: both "
+    "windows less their own means, O(window area))",
+    0, 0, kNl1Costs};
 inline constexpr ParamSpec kSgbmBlockSize{"sgbm.block_size",
                                           "StereoSGBM matcher: block size, pixels (odd)", 1, 21};
 inline constexpr ParamSpec kSgbmUniquenessRatio{"sgbm.uniqueness_ratio",
