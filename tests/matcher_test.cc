@@ -129,13 +129,20 @@ Reference MatchPlainly(const cv::Mat& left, const cv::Mat& right, const cv::Mat&
   cv::boxFilter(fl, wl, CV_32F, cv::Size(2 * n + 1, 2 * n + 1));
   cv::boxFilter(fr, wr, CV_32F, cv::Size(2 * n + 1, 2 * n + 1));
   const cv::Mat a = fl - wl, b = fr - wr;
+  cv::Mat mr;
+  cv::boxFilter(right, mr, CV_32F, cv::Size(n, n));
+  const bool window_mean = o.cost == "window_mean";
   auto cost = [&](int x, int y, int d) {
     const int xr = x - d;
     if (x - h < 0 || x + h >= cols || xr - h < 0 || xr + h >= cols) return inf;
+    // The paper's: both windows less their own means.
+    const float offset = ml.at<float>(y, x) - mr.at<float>(y, xr);
     float c = 0;
     for (int dy = -h; dy <= h; ++dy)
       for (int dx = -h; dx <= h; ++dx)
-        c += std::abs(a.at<float>(y + dy, x + dx) - b.at<float>(y + dy, xr + dx));
+        c += window_mean
+                 ? std::abs(fl.at<float>(y + dy, x + dx) - fr.at<float>(y + dy, xr + dx) - offset)
+                 : std::abs(a.at<float>(y + dy, x + dx) - b.at<float>(y + dy, xr + dx));
     return c / (n * n);
   };
   auto sub = [](double c0, double c1, double c2) {
@@ -242,7 +249,9 @@ TEST_CASE("the cost-volume matcher gives what its rules give, pixel by pixel", "
       lo.at<float>(y, x) = static_cast<float>(l);
       hi.at<float>(y, x) = static_cast<float>(u);
     }
-  const fovea::Nl1Options options;
+  fovea::Nl1Options options;
+  options.cost = GENERATE(as<std::string>(), "window_mean", "prenormalized");
+  INFO("cost " << options.cost);
   const Reference ref = MatchPlainly(left, right, lo, hi, options);
   const fovea::DisparityMap fast = fovea::Nl1Matcher(options).Match(left, right, lo, hi);
   CHECK(fast.searched == ref.searched);

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <numeric>
 #include <set>
 
 #include "commands.h"
@@ -122,6 +123,36 @@ fovea::StageTimes SumTimes(const std::vector<fovea::FixationRecord>& records) {
   return sum;
 }
 
+// The algorithm's compute per fixation (selection, vergence, foveal stereo,
+// integration; refused attempts counted with the fixation that followed
+// them), excluding simulated rendering and physics: over the run, and over
+// its first and last 25 fixations (whether it grows with the map).
+struct ComputePerFixation {
+  double mean_s = 0, first_s = 0, last_s = 0;
+};
+
+ComputePerFixation PerFixation(const fovea::FoveaRun& run) {
+  std::vector<double> per;  // by fixation
+  double pending = 0;
+  for (const auto& r : run.records) {
+    pending += r.time.ComputeS();
+    if (r.ok) {
+      per.push_back(pending);
+      pending = 0;
+    }
+  }
+  ComputePerFixation c;
+  if (per.empty()) return c;
+  auto mean = [](auto begin, auto end) {
+    return std::accumulate(begin, end, 0.0) / std::max<long>(1, std::distance(begin, end));
+  };
+  const size_t n = std::min<size_t>(25, per.size());
+  c.mean_s = mean(per.begin(), per.end());
+  c.first_s = mean(per.begin(), per.begin() + n);
+  c.last_s = mean(per.end() - n, per.end());
+  return c;
+}
+
 // summary.json of a FOVEA run.
 nlohmann::json FoveaSummary(const fovea::FoveaRun& run, const MapScore& score,
                             const std::string& scene_path, const RunConfig& config,
@@ -142,16 +173,20 @@ nlohmann::json FoveaSummary(const fovea::FoveaRun& run, const MapScore& score,
       {"patches", run.idr.map.size()},
       {"stop_reason", run.idr.stop_reason}};
   const fovea::StageTimes sum = SumTimes(run.records);
-  summary["time_s"] = {{"scene_load_and_reference", reference_s},
-                       {"idr_compute", run.idr.compute_time_s},
-                       {"select", sum.select_s},
-                       {"verge", sum.verge_s},
-                       {"servo_wall", sum.servo_s},
-                       {"foveal", sum.foveal_s},
-                       {"match", sum.match_s},
-                       {"integrate", sum.integrate_s},
-                       {"scoring", recorder.scoring_s},
-                       {"outputs", recorder.output_s}};
+  const ComputePerFixation per = PerFixation(run);
+  summary["time_s"] = {
+      {"scene_load_and_reference", reference_s},
+      {"idr_compute", run.idr.compute_time_s},
+      {"select", sum.select_s},
+      {"verge", sum.verge_s},
+      {"servo_wall", sum.servo_s},
+      {"foveal", sum.foveal_s},
+      {"match", sum.match_s},
+      {"integrate", sum.integrate_s},
+      {"scoring", recorder.scoring_s},
+      {"outputs", recorder.output_s},
+      {"compute_per_fixation",
+       {{"mean", per.mean_s}, {"first_25", per.first_s}, {"last_25", per.last_s}}}};
   return summary;
 }
 
@@ -219,6 +254,12 @@ int Run(const RunArgs& args) {
                "%.1f s\n",
                wall, sum.servo_s, run.idr.compute_time_s, sum.foveal_s, sum.match_s, sum.select_s,
                sum.integrate_s, recorder.scoring_s, recorder.output_s, run.motion_time_s);
+  const nlohmann::json& per = summary["time_s"]["compute_per_fixation"];
+  std::fprintf(stderr,
+               "fovea run: compute per fixation %.0f ms (rendering and physics excluded); first 25 "
+               "fixations %.0f ms, last 25 %.0f ms\n",
+               1e3 * per["mean"].get<double>(), 1e3 * per["first_25"].get<double>(),
+               1e3 * per["last_25"].get<double>());
   return 0;
 }
 

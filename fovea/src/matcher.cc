@@ -115,32 +115,46 @@ FOVEA_SIMD_CLONES void FillPrenormalized(const cv::Mat& a, const cv::Mat& b, int
 
 // The paper's cost: sum |(L - mean L) - (R - mean R)| with both means over
 // the windows being compared, which no running sum can share: O(window
-// area) per pixel and disparity. Kept for comparison (nl1.cost).
-void FillWindowMean(const cv::Mat& l, const cv::Mat& r, const cv::Mat& ml, const cv::Mat& mr, int h,
-                    CostVolume* v) {
+// area) per pixel and disparity, but each disparity's row at once, the
+// window's offsets a loop over contiguous columns that the compiler
+// vectorizes (each pixel's sum in the same order as one pixel at a time).
+// `l`, `r`: the images as CV_32F; `ml`, `mr`: their window means.
+FOVEA_SIMD_CLONES void FillWindowMean(const cv::Mat& l, const cv::Mat& r, const cv::Mat& ml,
+                                      const cv::Mat& mr, int h, CostVolume* v) {
   const float scale = 1.0f / ((2 * h + 1) * (2 * h + 1));
-  for (int d = v->dlo; d < v->dlo + v->nd; ++d)
+  const int cols = l.cols;
+  std::vector<float> offset, acc;
+  for (int d = v->dlo; d < v->dlo + v->nd; ++d) {
+    const int x0 = v->x0[d - v->dlo], width = v->width[d - v->dlo];
+    if (width <= 0) continue;
+    // Right windows inside the image: x - d - h >= 0 and x - d + h < cols.
+    const int valid0 = std::clamp(d + h - x0, 0, width);
+    const int valid1 = std::clamp(cols + d - h - x0, valid0, width);
+    const int n = valid1 - valid0, first = x0 + valid0;
+    offset.resize(n);
+    acc.resize(n);
     for (int y = v->y0; y < v->y0 + v->rows; ++y) {
-      const int x0 = v->x0[d - v->dlo], width = v->width[d - v->dlo];
-      if (width <= 0) continue;
       float* out = v->Row(y, d);
-      for (int i = 0; i < width; ++i) {
-        const int x = x0 + i, xr = x - d;
-        if (xr - h < 0 || xr + h >= l.cols) {
-          out[i] = kInf;
-          continue;
-        }
-        const float offset = ml.at<float>(y, x) - mr.at<float>(y, xr);
-        float c = 0;
-        for (int dy = -h; dy <= h; ++dy) {
-          const uchar* pl = l.ptr<uchar>(y + dy) + x;
-          const uchar* pr = r.ptr<uchar>(y + dy) + xr;
-          for (int dx = -h; dx <= h; ++dx)
-            c += std::abs(static_cast<float>(pl[dx]) - pr[dx] - offset);
-        }
-        out[i] = c * scale;
+      std::fill(out, out + valid0, kInf);
+      std::fill(out + valid1, out + width, kInf);
+      if (n <= 0) continue;
+      const float* __restrict pml = ml.ptr<float>(y) + first;
+      const float* __restrict pmr = mr.ptr<float>(y) + first - d;
+      float* __restrict o = offset.data();
+      float* __restrict c = acc.data();
+      for (int i = 0; i < n; ++i) {
+        o[i] = pml[i] - pmr[i];
+        c[i] = 0;
       }
+      for (int dy = -h; dy <= h; ++dy) {
+        const float* __restrict pl = l.ptr<float>(y + dy) + first;
+        const float* __restrict pr = r.ptr<float>(y + dy) + first - d;
+        for (int dx = -h; dx <= h; ++dx)
+          for (int i = 0; i < n; ++i) c[i] += std::abs(pl[i + dx] - pr[i + dx] - o[i]);
+      }
+      for (int i = 0; i < n; ++i) out[valid0 + i] = c[i] * scale;
     }
+  }
 }
 
 // The sub-pixel offset of a minimum c1 between c0 and c2 by the equiangular
@@ -479,8 +493,9 @@ DisparityMap Nl1Matcher::MatchCrop(const cv::Mat& left, const cv::Mat& right, co
   cv::boxFilter(left, ml, CV_32F, cv::Size(n, n));
   cv::boxFilter(right, mr, CV_32F, cv::Size(n, n));
   const bool prenormalized = options_.cost == "prenormalized";
-  cv::Mat image, a, b;
+  cv::Mat image, right_image, a, b;
   left.convertTo(image, CV_32F);
+  if (!prenormalized) right.convertTo(right_image, CV_32F);
   if (prenormalized) {
     // Each image less its mean over twice the window: a narrower mean
     // filters away the texture's lower frequencies, and a band that misses
@@ -506,7 +521,7 @@ DisparityMap Nl1Matcher::MatchCrop(const cv::Mat& left, const cv::Mat& right, co
     if (prenormalized)
       FillPrenormalized(a, b, h, &v);
     else
-      FillWindowMean(left, right, ml, mr, h, &v);
+      FillWindowMean(image, right_image, ml, mr, h, &v);
     for (int y = y0; y < y1; ++y) {
       w.Find(v, bands, y);
       MatchRow(bands, y, options_.lr_tolerance_px, &w, &out, &counts);

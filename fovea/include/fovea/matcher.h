@@ -29,21 +29,24 @@ struct Nl1Options {
   int window_half_px = 3;        ///< a 7 x 7 window
   double min_texture_dn = 2.0;   ///< mean absolute deviation of the left window
   double lr_tolerance_px = 1.0;  ///< left-right check
-  /// "prenormalized" or "window_mean" (params::kNl1Cost).
-  std::string cost = "prenormalized";
+  /// "window_mean" (the paper's) or "prenormalized" (params::kNl1Cost).
+  std::string cost = "window_mean";
   void Check() const;  ///< throws rig::InputError naming the key (fovea/params.h)
 };
 
-/// Normalized L1 window matching, winner-take-all, parabola sub-pixel
-/// refinement, left-right consistency check; confidence from the margin
-/// between the best and the second-best non-adjacent cost. The cost is the
-/// mean absolute difference of mean-free windows: by default each image less
-/// its local mean over twice the window (pre-normalized, so that window sums
-/// run), or the
-/// paper's sum |(L - mean L) - (R - mean R)| with the means of the two
-/// windows compared (Nl1Options::cost). Costs are computed per tile of the
-/// level over the union of its pixels' bands, once for both directions of
-/// the left-right check (the right pixel's costs are the left pixels').
+/// Normalized L1 window matching, winner-take-all, equiangular sub-pixel
+/// refinement, left-right consistency check (the matched right pixel's own
+/// winner among the left pixels whose bands reach it; the two views'
+/// sub-pixel estimates are averaged); confidence from the margin between the
+/// best and the second-best non-adjacent cost. The cost is the mean absolute
+/// difference of mean-free windows: by default the paper's sum |(L - mean L)
+/// - (R - mean R)| with the means of the two windows compared, or each image
+/// less its local mean over twice the window (pre-normalized, so that window
+/// sums run: several times faster, but beside depth edges the two views'
+/// local means differ and the map's edges come out worse; README, "The
+/// foveated matcher"). Costs are computed per strip of rows, each disparity
+/// only over the columns whose bands hold it, once for both directions of
+/// the left-right check.
 class Nl1Matcher : public StereoMatcher {
  public:
   explicit Nl1Matcher(const Nl1Options& options = {});
