@@ -471,24 +471,20 @@ DisparityMap Nl1Matcher::Match(const cv::Mat& left, const cv::Mat& right, const 
   const int c1 = clamp_x(std::max<double>(x1, x1 - std::floor(dlo) + 1) + h + 1);
   const cv::Rect crop(c0, std::max(0, y0 - h), c1 - c0,
                       std::min(left.rows, y1 + h + 1) - std::max(0, y0 - h));
-  DisparityMap part = MatchCrop(left(crop), right(crop), lo_px(crop), hi_px(crop));
-  part.disparity_px.copyTo(out.disparity_px(crop));
-  part.confidence.copyTo(out.confidence(crop));
-  out.searched = part.searched;
-  out.matched = part.matched;
-  out.rejected_texture = part.rejected_texture;
-  out.rejected_lr = part.rejected_lr;
-  out.rejected_edge = part.rejected_edge;
-  return out;
+  DisparityMap part = out;
+  part.disparity_px = out.disparity_px(crop);  // views: the crop writes into `out`
+  part.confidence = out.confidence(crop);
+  MatchCrop(left(crop), right(crop), lo_px(crop), hi_px(crop), &part);
+  part.disparity_px = out.disparity_px;
+  part.confidence = out.confidence;
+  return part;
 }
 
-DisparityMap Nl1Matcher::MatchCrop(const cv::Mat& left, const cv::Mat& right, const cv::Mat& lo_px,
-                                   const cv::Mat& hi_px) const {
+void Nl1Matcher::MatchCrop(const cv::Mat& left, const cv::Mat& right, const cv::Mat& lo_px,
+                           const cv::Mat& hi_px, DisparityMap* result) const {
   const int h = options_.window_half_px, n = 2 * h + 1;
-  DisparityMap out;
-  out.disparity_px = cv::Mat(left.size(), CV_32F, cv::Scalar(std::nanf("")));
-  out.confidence = cv::Mat(left.size(), CV_32F, cv::Scalar(0));
-  if (left.rows < n || left.cols < n) return out;
+  DisparityMap& out = *result;
+  if (left.rows < n || left.cols < n) return;
   cv::Mat ml, mr;
   cv::boxFilter(left, ml, CV_32F, cv::Size(n, n));
   cv::boxFilter(right, mr, CV_32F, cv::Size(n, n));
@@ -532,7 +528,6 @@ DisparityMap Nl1Matcher::MatchCrop(const cv::Mat& left, const cv::Mat& right, co
   out.rejected_texture = counts.rejected_texture;
   out.rejected_lr = counts.rejected_lr;
   out.rejected_edge = counts.rejected_edge;
-  return out;
 }
 
 }  // namespace fovea

@@ -66,8 +66,8 @@ void WindowToPlanarDepth(const mjModel* m, const cv::Mat& window, cv::Mat* depth
 
 }  // namespace
 
-void OffscreenRenderer::RenderLabels(const mjModel* m, mjData* d, int cam_id, int width_px,
-                                     int height_px, cv::Mat* depth_m, cv::Mat* geom_ids) {
+void OffscreenRenderer::UpdateScene(const mjModel* m, mjData* d, int cam_id) {
+  // Several renderers may live in one process (tests): make ours current.
   OSMesaMakeCurrent(context_, window_buffer_.data(), GL_UNSIGNED_BYTE, width_px_, height_px_);
   mjr_setBuffer(mjFB_OFFSCREEN, &context_mj_);
   mjvCamera camera;
@@ -75,6 +75,11 @@ void OffscreenRenderer::RenderLabels(const mjModel* m, mjData* d, int cam_id, in
   camera.type = mjCAMERA_FIXED;
   camera.fixedcamid = cam_id;
   mjv_updateScene(m, d, &option_, nullptr, &camera, mjCAT_ALL, &scene_);
+}
+
+void OffscreenRenderer::RenderLabels(const mjModel* m, mjData* d, int cam_id, int width_px,
+                                     int height_px, cv::Mat* depth_m, cv::Mat* geom_ids) {
+  UpdateScene(m, d, cam_id);
   // Each geom in its own colour, segid + 1 as r + 256 g + 65536 b, unlit.
   scene_.flags[mjRND_SEGMENT] = 1;
   scene_.flags[mjRND_IDCOLOR] = 1;
@@ -105,14 +110,7 @@ void OffscreenRenderer::RenderLabels(const mjModel* m, mjData* d, int cam_id, in
 
 void OffscreenRenderer::Render(const mjModel* m, mjData* d, int cam_id, int width_px, int height_px,
                                cv::Mat* rgb, cv::Mat* depth_m) {
-  // Several renderers may live in one process (tests): make ours current.
-  OSMesaMakeCurrent(context_, window_buffer_.data(), GL_UNSIGNED_BYTE, width_px_, height_px_);
-  mjr_setBuffer(mjFB_OFFSCREEN, &context_mj_);
-  mjvCamera camera;
-  mjv_defaultCamera(&camera);
-  camera.type = mjCAMERA_FIXED;
-  camera.fixedcamid = cam_id;
-  mjv_updateScene(m, d, &option_, nullptr, &camera, mjCAT_ALL, &scene_);
+  UpdateScene(m, d, cam_id);
   const mjrRect viewport = {0, 0, width_px, height_px};
   mjr_render(viewport, &scene_, &context_mj_);
 

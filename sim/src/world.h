@@ -39,6 +39,8 @@ class OffscreenRenderer {
                     cv::Mat* depth_m, cv::Mat* geom_ids);
 
  private:
+  /// Makes this renderer current and fills its scene for camera `cam_id`.
+  void UpdateScene(const mjModel* m, mjData* d, int cam_id);
   OSMesaContext context_ = nullptr;
   std::vector<unsigned char> window_buffer_;
   int width_px_, height_px_;
