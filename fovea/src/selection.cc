@@ -74,6 +74,36 @@ Eigen::Vector3d SelectionContext::MapPoint(int x, int y) const {
          (map_depth_m.at<float>(y, x) * view.intrinsics.Ray({double(x), double(y)}));
 }
 
+namespace {
+
+// The pixels whose map point can lie within `r` of p_W: the bounding box of
+// the images of the cube of half side r about p_W (a convex set's image lies
+// in the hull of its corners' images), a pixel spare each side; the whole
+// image when the cube reaches behind the camera or the lens distorts.
+cv::Rect PixelsNear(const rig::CameraView& view, const Eigen::Vector3d& p_W, double r) {
+  const rig::CameraIntrinsics& k = view.intrinsics;
+  const cv::Rect image(0, 0, k.width_px, k.height_px);
+  if (!k.distortion.empty()) return image;
+  const Eigen::Isometry3d camera_T_world = view.world_T_camera.inverse();
+  double u0 = std::numeric_limits<double>::infinity(), v0 = u0, u1 = -u0, v1 = -u0;
+  for (int i = 0; i < 8; ++i) {
+    const Eigen::Vector3d corner(i & 1 ? r : -r, i & 2 ? r : -r, i & 4 ? r : -r);
+    const Eigen::Vector3d q = camera_T_world * (p_W + corner);
+    if (q.z() <= 1e-6) return image;
+    const double u = k.fx_px * q.x() / q.z() + k.cx_px, v = k.fy_px * q.y() / q.z() + k.cy_px;
+    u0 = std::min(u0, u);
+    u1 = std::max(u1, u);
+    v0 = std::min(v0, v);
+    v1 = std::max(v1, v);
+  }
+  auto clip = [](double x, int n) { return static_cast<int>(std::clamp(x, -1.0, n + 1.0)); };
+  const cv::Point tl(clip(std::floor(u0) - 1, k.width_px), clip(std::floor(v0) - 1, k.height_px));
+  const cv::Point br(clip(std::ceil(u1) + 2, k.width_px), clip(std::ceil(v1) + 2, k.height_px));
+  return cv::Rect(tl, br) & image;
+}
+
+}  // namespace
+
 cv::Mat LocalSuppression::Evaluate(const SelectionContext& c) const {
   // Every settled point, and each point aimed at where the servo settled
   // farther than the revisit radius from it.
@@ -89,17 +119,26 @@ cv::Mat LocalSuppression::Evaluate(const SelectionContext& c) const {
       double& wp = w.at<double>(y, x);
       if (level == static_cast<signed char>(PatchLevel::kFoveal)) wp = low_;
       if (level == static_cast<signed char>(PatchLevel::kPeripheral)) wp = peripheral_;
-      if (points.empty() || c.map_depth_m.at<float>(y, x) <= 0) continue;
-      const Eigen::Vector3d p = c.MapPoint(x, y);
-      for (const Eigen::Vector3d& f : points) {
-        const double r = (p - f).norm();
-        if (r < revisit_) {
-          wp = 0;
-          break;
-        }
-        if (r < radius_) wp = std::min(wp, low_);
-      }
     }
+  // Each point suppresses only the pixels whose map points lie within the
+  // radius: visiting just the pixels it can reach keeps the cost per
+  // fixation from growing with the fixations made (0 within the revisit
+  // radius of any point, else at most low_ within the radius of any; the
+  // order of the points does not matter).
+  const double reach = std::max(radius_, revisit_);
+  for (const Eigen::Vector3d& f : points) {
+    const cv::Rect box = PixelsNear(c.view, f, reach);
+    for (int y = box.y; y < box.y + box.height; ++y)
+      for (int x = box.x; x < box.x + box.width; ++x) {
+        if (c.map_depth_m.at<float>(y, x) <= 0) continue;
+        double& wp = w.at<double>(y, x);
+        const double r = (c.MapPoint(x, y) - f).norm();
+        if (r < revisit_)
+          wp = 0;
+        else if (r < radius_)
+          wp = std::min(wp, low_);
+      }
+  }
   NormalizeSum(&w);
   return w;
 }
