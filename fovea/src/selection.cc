@@ -219,20 +219,25 @@ cv::Mat FixationSelector::Composite(const SelectionContext& c,
         v = 0;
         continue;
       }
-      if (refused_W.empty() && !c.region) continue;
+      if (!c.region) continue;
       const Eigen::Vector3d p_W = c.MapPoint(x, y);
-      if (c.region) {
-        const auto uv = ProjectWorldPoint(c.region->world_T_camera, c.region->intrinsics, p_W);
-        const auto& k = c.region->intrinsics;
-        if (!uv || uv->x() < b || uv->y() < b || uv->x() > k.width_px - 1 - b ||
-            uv->y() > k.height_px - 1 - b) {
-          v = 0;
-          continue;
-        }
-      }
-      for (const Eigen::Vector3d& r : refused_W)
-        if ((p_W - r).norm() < options_.refused_radius_m) v = 0;
+      const auto uv = ProjectWorldPoint(c.region->world_T_camera, c.region->intrinsics, p_W);
+      const auto& k = c.region->intrinsics;
+      if (!uv || uv->x() < b || uv->y() < b || uv->x() > k.width_px - 1 - b ||
+          uv->y() > k.height_px - 1 - b)
+        v = 0;
     }
+  // Each refused point clears the pixels near it, visiting only those it can
+  // reach (a pixel already at 0 stays there): the cost does not grow with the
+  // attempts refused.
+  for (const Eigen::Vector3d& r : refused_W) {
+    const cv::Rect box = PixelsNear(c.view, r, options_.refused_radius_m);
+    for (int y = box.y; y < box.y + box.height; ++y)
+      for (int x = box.x; x < box.x + box.width; ++x) {
+        double& v = composite.at<double>(y, x);
+        if (v != 0 && (c.MapPoint(x, y) - r).norm() < options_.refused_radius_m) v = 0;
+      }
+  }
   NormalizeSum(&composite);
   return composite;
 }
