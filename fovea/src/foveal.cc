@@ -78,6 +78,20 @@ cv::Rect LevelPixels(const cv::Rect& rect, double scale) {
   return {x0, y0, x1 - x0, y1 - y0};
 }
 
+// Pixel (x, y) of a level with `scale` full-resolution pixels per pixel:
+// its centre in full-resolution pixels (u, v) and the full-resolution pixel
+// nearest it (ui, vi), inside the image.
+struct FullResolutionPixel {
+  double u, v;
+  int ui, vi;
+};
+
+FullResolutionPixel AtFullResolution(int x, int y, double scale, const rig::CameraIntrinsics& k) {
+  const double u = (x + 0.5) * scale - 0.5, v = (y + 0.5) * scale - 0.5;
+  return {u, v, std::clamp(static_cast<int>(std::lround(u)), 0, k.width_px - 1),
+          std::clamp(static_cast<int>(std::lround(v)), 0, k.height_px - 1)};
+}
+
 // Disparities of one left pixel at planar depths z, in a level's pixels:
 // its ray is found once (CameraIntrinsics::Ray), each depth then costs a few
 // multiplications (DisparityAtDepth's arithmetic, unrolled).
@@ -133,9 +147,7 @@ SearchRanges LevelRanges(const rig::StereoFrame& frame, const Tessellation& t,
   const cv::Rect inside = LevelPixels(level.rect, s) & cv::Rect(cv::Point(), size);
   for (int y = inside.y; y < inside.br().y; ++y)
     for (int x = inside.x; x < inside.br().x; ++x) {
-      const double u = (x + 0.5) * s - 0.5, v = (y + 0.5) * s - 0.5;
-      const int ui = std::clamp(static_cast<int>(std::lround(u)), 0, k.width_px - 1);
-      const int vi = std::clamp(static_cast<int>(std::lround(v)), 0, k.height_px - 1);
+      const auto [u, v, ui, vi] = AtFullResolution(x, y, s, k);
       if (!level.rect.contains({ui, vi}) || t.mask.at<uchar>(vi, ui) == 0) continue;
       double dlo, dhi;
       const float cd = coarse ? coarse->at<float>(std::min(coarse->rows - 1, y / 2),
@@ -190,9 +202,7 @@ SilentCheck CheckSilent(const rig::StereoFrame& frame, const Tessellation& t,
   const cv::Rect& outer = t.rects.back();
   for (int y = 0; y < size.height; ++y)
     for (int x = 0; x < size.width; ++x) {
-      const double u = (x + 0.5) * s - 0.5, v = (y + 0.5) * s - 0.5;
-      const int ui = std::clamp(static_cast<int>(std::lround(u)), 0, k.width_px - 1);
-      const int vi = std::clamp(static_cast<int>(std::lround(v)), 0, k.height_px - 1);
+      const auto [u, v, ui, vi] = AtFullResolution(x, y, s, k);
       if (!outer.contains({ui, vi}) || t.mask.at<uchar>(vi, ui) == 0 ||
           map_depth.at<float>(vi, ui) > 0)
         continue;

@@ -36,10 +36,10 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 // span only the columns some pixel of the strip needs them at.
 constexpr int kStripRows = 16;
 
-// The matching costs of one strip of rows: at(x, y, d) is the cost of the
-// left window centred at (x, y) against the right window at (x - d, y),
+// The matching costs of one strip of rows: the cost at (x, y, d) is that of
+// the left window centred at (x, y) against the right window at (x - d, y),
 // +inf where the right window leaves the image. Each disparity d holds the
-// columns [x0[d], x0[d] + width[d]), x fastest.
+// columns [x0[d], x0[d] + width[d]), x fastest (Row).
 struct CostVolume {
   int y0 = 0, rows = 0, dlo = 0, nd = 0;
   std::vector<int> x0, width;
@@ -48,14 +48,6 @@ struct CostVolume {
   float* Row(int y, int d) {
     const int i = d - dlo;
     return &c[offset[i] + static_cast<size_t>(y - y0) * width[i]];
-  }
-  bool Holds(int x, int d) const {
-    const int i = d - dlo;
-    return i >= 0 && i < nd && x >= x0[i] && x < x0[i] + width[i];
-  }
-  float at(int x, int y, int d) const {
-    const int i = d - dlo;
-    return c[offset[i] + static_cast<size_t>(y - y0) * width[i] + (x - x0[i])];
   }
 };
 
@@ -166,21 +158,16 @@ double SubPixel(double c0, double c1, double c2) {
   return slope > 0 ? std::clamp(0.5 * (c0 - c2) / slope, -0.5, 0.5) : 0.0;
 }
 
-// What the matcher counted (DisparityMap's counters).
-struct Counts {
-  int searched = 0, matched = 0, rejected_texture = 0, rejected_lr = 0, rejected_edge = 0;
-};
-
 // Each pixel's integer search band (lo > hi: none).
 struct Bands {
   cv::Mat lo, hi;  ///< CV_32S
 };
 
-// The bands of rows [y0, y1) after the range and texture tests; `image` is
-// the left image as CV_32F, `ml` its window means.
+// The bands of rows [y0, y1) after the range and texture tests, counted in
+// `counts`; `image` is the left image as CV_32F, `ml` its window means.
 FOVEA_SIMD_CLONES void SearchBands(const cv::Mat& image, const cv::Mat& ml, const cv::Mat& lo_px,
                                    const cv::Mat& hi_px, const Nl1Options& options, int y0, int y1,
-                                   Bands* b, Counts* counts) {
+                                   Bands* b, DisparityMap* counts) {
   const int h = options.window_half_px, n = 2 * h + 1;
   const float min_sum = static_cast<float>(options.min_texture_dn * n * n);
   std::vector<float> mad(image.cols);
@@ -381,7 +368,7 @@ struct RowWinners {
 // sub-pixel, where its minimum lies inside its band and the matched right
 // pixel's own winner agrees (left-right check), with its confidence.
 void MatchRow(const Bands& bands, int y, double lr_tolerance_px, const RowWinners* w,
-              DisparityMap* out, Counts* counts) {
+              DisparityMap* out) {
   const int* blo = bands.lo.ptr<int>(y);
   const int* bhi = bands.hi.ptr<int>(y);
   float* disparity = out->disparity_px.ptr<float>(y);
@@ -391,7 +378,7 @@ void MatchRow(const Bands& bands, int y, double lr_tolerance_px, const RowWinner
     if (lo > hi) continue;
     const float c1 = w->cost[x];
     if (!std::isfinite(c1)) {
-      ++counts->rejected_edge;
+      ++out->rejected_edge;
       continue;
     }
     // The minimum needs a finite neighbour on both sides in the band.
@@ -399,7 +386,7 @@ void MatchRow(const Bands& bands, int y, double lr_tolerance_px, const RowWinner
     const float c0 = d > lo ? w->At(x, d - 1) : kInf;
     const float c2 = d < hi ? w->At(x, d + 1) : kInf;
     if (!std::isfinite(c0) || !std::isfinite(c2)) {
-      ++counts->rejected_edge;
+      ++out->rejected_edge;
       continue;
     }
     const double sub = SubPixel(c0, c1, c2);
@@ -407,7 +394,7 @@ void MatchRow(const Bands& bands, int y, double lr_tolerance_px, const RowWinner
     // pixels whose bands reach it, from the same costs.
     const int xr = x - d, dr = w->right_d[xr];
     if (!std::isfinite(w->right_cost[xr])) {
-      ++counts->rejected_lr;
+      ++out->rejected_lr;
       continue;
     }
     double right = dr;  // the right pixel's disparity, sub-pixel where it can be
@@ -421,7 +408,7 @@ void MatchRow(const Bands& bands, int y, double lr_tolerance_px, const RowWinner
     if (right_refined) right += SubPixel(r0, w->right_cost[xr], r2);
     const double left = d + sub;
     if (std::abs(right - left) > lr_tolerance_px) {
-      ++counts->rejected_lr;
+      ++out->rejected_lr;
       continue;
     }
     // Both views' estimates of the same point, averaged: their window
@@ -430,7 +417,7 @@ void MatchRow(const Bands& bands, int y, double lr_tolerance_px, const RowWinner
     const float second = w->second[x];
     const float margin = std::isfinite(second) ? (second - c1) / (second + 1e-3f) : 1.0f;
     confidence[x] = std::clamp(margin, 0.0f, 1.0f);
-    ++counts->matched;
+    ++out->matched;
   }
 }
 
@@ -471,8 +458,8 @@ DisparityMap Nl1Matcher::Match(const cv::Mat& left, const cv::Mat& right, const 
   const int c1 = clamp_x(std::max<double>(x1, x1 - std::floor(dlo) + 1) + h + 1);
   const cv::Rect crop(c0, std::max(0, y0 - h), c1 - c0,
                       std::min(left.rows, y1 + h + 1) - std::max(0, y0 - h));
-  DisparityMap part = out;
-  part.disparity_px = out.disparity_px(crop);  // views: the crop writes into `out`
+  DisparityMap part;  // views of `out`'s maps: the crop writes into them
+  part.disparity_px = out.disparity_px(crop);
   part.confidence = out.confidence(crop);
   MatchCrop(left(crop), right(crop), lo_px(crop), hi_px(crop), &part);
   part.disparity_px = out.disparity_px;
@@ -491,8 +478,9 @@ void Nl1Matcher::MatchCrop(const cv::Mat& left, const cv::Mat& right, const cv::
   const bool prenormalized = options_.cost == "prenormalized";
   cv::Mat image, right_image, a, b;
   left.convertTo(image, CV_32F);
-  if (!prenormalized) right.convertTo(right_image, CV_32F);
-  if (prenormalized) {
+  if (!prenormalized) {
+    right.convertTo(right_image, CV_32F);
+  } else {
     // Each image less its mean over twice the window: a narrower mean
     // filters away the texture's lower frequencies, and a band that misses
     // the truth then finds more false interior minima (matcher_test).
@@ -507,8 +495,7 @@ void Nl1Matcher::MatchCrop(const cv::Mat& left, const cv::Mat& right, const cv::
               cv::Mat(left.size(), CV_32S, cv::Scalar(0))};
   // Strips of rows are independent, but matching them on OpenCV's thread
   // pool did not pay on the 2-core machine (the README's figures): serial.
-  Counts counts;
-  SearchBands(image, ml, lo_px, hi_px, options_, h, left.rows - h, &bands, &counts);
+  SearchBands(image, ml, lo_px, hi_px, options_, h, left.rows - h, &bands, &out);
   CostVolume v;
   RowWinners w(left.cols);
   for (int y0 = h; y0 < left.rows - h; y0 += kStripRows) {
@@ -520,14 +507,9 @@ void Nl1Matcher::MatchCrop(const cv::Mat& left, const cv::Mat& right, const cv::
       FillWindowMean(image, right_image, ml, mr, h, &v);
     for (int y = y0; y < y1; ++y) {
       w.Find(v, bands, y);
-      MatchRow(bands, y, options_.lr_tolerance_px, &w, &out, &counts);
+      MatchRow(bands, y, options_.lr_tolerance_px, &w, &out);
     }
   }
-  out.searched = counts.searched;
-  out.matched = counts.matched;
-  out.rejected_texture = counts.rejected_texture;
-  out.rejected_lr = counts.rejected_lr;
-  out.rejected_edge = counts.rejected_edge;
 }
 
 }  // namespace fovea

@@ -7,27 +7,22 @@
 
 namespace sim {
 
-bool GroundTruth::Renderable(const rig::CameraIntrinsics& k) const {
-  return k.distortion.empty() && std::abs(k.fx_px - k.fy_px) <= 1e-9 * k.fx_px &&
-         std::abs(k.cx_px - 0.5 * (k.width_px - 1)) <= 1e-9 &&
-         std::abs(k.cy_px - 0.5 * (k.height_px - 1)) <= 1e-9 && k.width_px <= world_->width_px &&
-         k.height_px <= world_->height_px;
+std::optional<std::string> GroundTruth::WhyNotRenderable(const rig::CameraIntrinsics& k) const {
+  const mjModel* m = world_->m;
+  if (!k.distortion.empty() || std::abs(k.fx_px - k.fy_px) > 1e-9 * k.fx_px ||
+      std::abs(k.cx_px - 0.5 * (k.width_px - 1)) > 1e-9 ||
+      std::abs(k.cy_px - 0.5 * (k.height_px - 1)) > 1e-9)
+    return "true-depth rendering needs square pixels, a centred principal point and no distortion "
+           "(use RayCastDepth for other cameras)";
+  if (k.width_px > m->vis.global.offwidth || k.height_px > m->vis.global.offheight)
+    return "true-depth rendering: image larger than the offscreen buffer";
+  return std::nullopt;
 }
 
 void GroundTruth::PlaceTruthCamera(const Eigen::Isometry3d& world_T_camera,
                                    const rig::CameraIntrinsics& k) const {
   k.Check();
-  const mjModel* m = world_->m;
-  if (!k.distortion.empty() || std::abs(k.fx_px - k.fy_px) > 1e-9 * k.fx_px ||
-      std::abs(k.cx_px - 0.5 * (k.width_px - 1)) > 1e-9 ||
-      std::abs(k.cy_px - 0.5 * (k.height_px - 1)) > 1e-9) {
-    throw rig::RigError(
-        "true-depth rendering needs square pixels, a centred principal point and no distortion "
-        "(use RayCastDepth for other cameras)");
-  }
-  if (k.width_px > m->vis.global.offwidth || k.height_px > m->vis.global.offheight)
-    throw rig::RigError("true-depth rendering: image larger than the offscreen buffer");
-
+  if (const auto why = WhyNotRenderable(k)) throw rig::RigError(*why);
   // Place the truth camera (a world-body camera) at the pose and field asked.
   const int id = world_->truth_camera_id;
   const Eigen::Quaterniond q = MujocoCameraQuat(world_T_camera.linear());
@@ -55,7 +50,7 @@ TrueView GroundTruth::Render(const Eigen::Isometry3d& world_T_camera,
 GroundTruth::Labels GroundTruth::RenderLabels(const Eigen::Isometry3d& world_T_camera,
                                               const rig::CameraIntrinsics& k) const {
   k.Check();
-  if (!Renderable(k)) {
+  if (WhyNotRenderable(k)) {
     Labels l;
     l.depth_m = RayCastDepth(world_T_camera, k, &l.geom_ids);
     l.ray_cast = k.width_px * k.height_px;
@@ -64,7 +59,8 @@ GroundTruth::Labels GroundTruth::RenderLabels(const Eigen::Isometry3d& world_T_c
   PlaceTruthCamera(world_T_camera, k);
   World& w = *world_;
   if (!w.truth_renderer)
-    w.truth_renderer = new OffscreenRenderer(w.m, w.width_px, w.height_px, /*truth=*/true);
+    w.truth_renderer = new OffscreenRenderer(w.m, w.m->vis.global.offwidth,
+                                             w.m->vis.global.offheight, /*truth=*/true);
   Labels l;
   w.truth_renderer->RenderLabels(w.m, w.d, w.truth_camera_id, k.width_px, k.height_px, &l.depth_m,
                                  &l.geom_ids);

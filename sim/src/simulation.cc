@@ -227,8 +227,6 @@ std::unique_ptr<Simulation> Simulation::LoadImpl(const std::string& scene_path,
   sim->world_ = CompileWorld(scene_path, xml, from_memory, config, assets);
   World& w = *sim->world_;
   w.renderer = new OffscreenRenderer(w.m, config.width_px, config.height_px);
-  w.width_px = config.width_px;
-  w.height_px = config.height_px;
   sim->rig_ = std::make_unique<SimRig>(sim->world_.get(), config);
   sim->truth_ = std::make_unique<GroundTruth>(sim->world_.get());
   sim->config_ = config;

@@ -60,7 +60,6 @@ struct World {
   std::vector<unsigned char> visible_groups;    // mj_ray filter: groups 0-2
   OffscreenRenderer* renderer = nullptr;        // owned
   OffscreenRenderer* truth_renderer = nullptr;  // owned; made on first use (GroundTruth)
-  int width_px = 0, height_px = 0;              // the rig's images
 
   ~World();
 };

@@ -57,7 +57,7 @@ class Nl1Matcher : public StereoMatcher {
  private:
   /// Match on a crop that holds every searched pixel with its window and
   /// the right columns its band reaches; writes into `out`'s maps (views of
-  /// the crop, initialized) and sets its counts.
+  /// the crop, initialized) and counts into its counters.
   void MatchCrop(const cv::Mat& left, const cv::Mat& right, const cv::Mat& lo_px,
                  const cv::Mat& hi_px, DisparityMap* out) const;
   Nl1Options options_;

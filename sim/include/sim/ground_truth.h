@@ -49,7 +49,7 @@ class GroundTruth {
   /// beside a change of geom or a depth jump (edge rasterization). Agrees
   /// with RayCastDepth within 1 mm on every pixel of the catalog's views
   /// (ground_truth_test). Intrinsics Render cannot draw (distortion, an
-  /// off-centre principal point, larger than the rig's images) are ray cast
+  /// off-centre principal point, larger than the offscreen buffer) are ray cast
   /// on every pixel.
   struct Labels {
     cv::Mat depth_m;   ///< CV_32FC1, planar depth; 0 where nothing is hit
@@ -87,8 +87,9 @@ class GroundTruth {
 
  private:
   World* world_;
-  /// Whether RenderLabels can render these intrinsics (else it ray casts).
-  bool Renderable(const rig::CameraIntrinsics& intrinsics) const;
+  /// Why Render cannot draw these intrinsics (RenderLabels then ray casts);
+  /// nullopt when it can.
+  std::optional<std::string> WhyNotRenderable(const rig::CameraIntrinsics& intrinsics) const;
   /// Poses the truth camera; throws rig::RigError for intrinsics it cannot render.
   void PlaceTruthCamera(const Eigen::Isometry3d& world_T_camera,
                         const rig::CameraIntrinsics& intrinsics) const;
