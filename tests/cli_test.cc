@@ -278,10 +278,15 @@ TEST_CASE("a sweep over catalog, generated and numbered random scenes runs", "[c
 
 TEST_CASE("fovea fixate fixates a point the way fovea run does", "[cli][slow]") {
   // Noise off: the run's reference view draws from the noise generator before
-  // IDR, fixate's does not; without noise both see the same images.
+  // IDR, fixate's does not; without noise both see the same images. The
+  // run's first target is IDR's mapped point (a point the strategy chose may
+  // lie in a hole, whose servo search spans every depth: fixate aims at
+  // mapped points).
   const fs::path run = TempDir("same_run"), fix = TempDir("same_fix");
-  Result r = Fovea("run --scene two_planes --fixations 1 --set rig.noise_sigma_dn=0 --out " +
-                   run.string());
+  Result r = Fovea(
+      "run --scene two_planes --fixations 1 --set rig.noise_sigma_dn=0 --set "
+      "selection.first_fixation=idr --out " +
+      run.string());
   INFO(r.err);
   REQUIRE(r.exit_code == 0);
   std::ifstream records(run / "fixations.jsonl");

@@ -143,7 +143,8 @@ TEST_CASE("every parameter of the table: both ends pass, just outside is refused
   }
   CHECK(numbers > 70);
   CHECK(flags > 10);
-  CHECK(choices == 4);  // method, matcher, rig type, nl1.cost
+  CHECK(choices ==
+        6);  // method, matcher, rig type, nl1.cost, selection strategy and first fixation
 }
 
 TEST_CASE("the options' own Check() names the YAML key and uses the table's range", "[config]") {

@@ -81,6 +81,33 @@ TEST_CASE("patch map: rays hit the nearest patch", "[fovea][patch]") {
   CHECK(map.patches()[0].SizeM() == Approx(std::sqrt(2.0)));
 }
 
+TEST_CASE("patch map: a ray through a quad's diagonal or a shared edge hits it", "[fovea][patch]") {
+  // A grid of 4 px patches at 1 m seen at 150 px focal length: pixel centres
+  // fall exactly on the diagonals, where rounding once let rays slip between
+  // a quad's two triangles.
+  auto at = [](double u, double v) {
+    return Eigen::Vector3d((u - 79.5) / 150, 1, -(v - 59.5) / 150);
+  };
+  fovea::PatchMap map;
+  for (int y = 0; y < 120; y += 4)
+    for (int x = 0; x < 160; x += 4) {
+      fovea::Patch p;
+      p.corners_W = {at(x - 0.5, y - 0.5), at(x + 3.5, y - 0.5), at(x + 3.5, y + 3.5),
+                     at(x - 0.5, y + 3.5)};
+      map.Add(p);
+    }
+  int missed = 0, missed_brute = 0;
+  for (int v = 0; v < 120; ++v)
+    for (int u = 0; u < 160; ++u) {
+      const Eigen::Vector3d d = at(u, v).normalized();
+      const auto hit = map.CastRay(Eigen::Vector3d::Zero(), d);
+      missed += !hit || std::abs(hit->distance_m * d.y() - 1) > 1e-9;
+      missed_brute += !map.CastRayBruteForce(Eigen::Vector3d::Zero(), d);
+    }
+  CHECK(missed == 0);  // 245 of 19,200 before the edges were closed
+  CHECK(missed_brute == 0);
+}
+
 TEST_CASE("patch map: rendering into a view gives depth and patch ids", "[fovea][patch]") {
   fovea::PatchMap map;
   map.Add(Square(2.0, 0.5));

@@ -172,6 +172,12 @@ nlohmann::json FoveaSummary(const fovea::FoveaRun& run, const MapScore& score,
       {"final_baseline_m", run.idr.stages.empty() ? 0.0 : run.idr.stages.back().baseline_m},
       {"patches", run.idr.map.size()},
       {"stop_reason", run.idr.stop_reason}};
+  double pan = 0, tilt = 0, carriage = 0, loop_motion = 0;
+  for (const auto& r : run.records)
+    pan += r.pan_rad, tilt += r.tilt_rad, carriage += r.carriage_m, loop_motion += r.motion_time_s;
+  summary["selection_strategy"] = config.fovea.selection.Strategy();
+  summary["travel"] = run_folder::TravelJson(pan, tilt, carriage);
+  summary["travel"]["motion_time_s"] = loop_motion;
   const fovea::StageTimes sum = SumTimes(run.records);
   const ComputePerFixation per = PerFixation(run);
   summary["time_s"] = {
@@ -217,6 +223,10 @@ int Run(const RunArgs& args) {
   t = Clock::now();
   const MapScore score =
       ScoreMap(run.map, ref, sim->truth(), config.fovea.fixation.baseline_m, /*per_patch=*/true);
+  // Where the fixations started from: the curves of coverage against
+  // fixations and motion begin here.
+  const MapScore idr_score =
+      ScoreMap(run.idr.map, ref, sim->truth(), config.fovea.fixation.baseline_m, false);
   const nlohmann::json vs_static =
       config.compare_static ? VsStatic(rig, config, run.map, ref) : nlohmann::json();
   recorder.scoring_s += Since(t);
@@ -231,6 +241,8 @@ int Run(const RunArgs& args) {
   nlohmann::json summary =
       FoveaSummary(run, score, sim->scene_path(), config, recorder, reference_s, wall);
   if (!vs_static.is_null()) summary["vs_static"] = vs_static;
+  const nlohmann::json idr_json = ScoreJson(idr_score);
+  for (const char* key : {"coverage", "good_coverage"}) summary["idr"][key] = idr_json.at(key);
   WriteTextAtomic(dir + "/" + rf::kSummary, summary.dump(2) + "\n");
   folder.Commit();
   const fovea::StageTimes sum = SumTimes(run.records);
@@ -260,6 +272,15 @@ int Run(const RunArgs& args) {
                "fixations %.0f ms, last 25 %.0f ms\n",
                1e3 * per["mean"].get<double>(), 1e3 * per["first_25"].get<double>(),
                1e3 * per["last_25"].get<double>());
+  const nlohmann::json& travel = summary["travel"];
+  const double n = std::max(1, run.fixations_done);
+  std::fprintf(stderr,
+               "fovea run: strategy %s: selection %.0f ms per fixation; per fixation pan %.1f deg, "
+               "tilt %.1f deg, carriages %.0f mm, motion %.2f s (both cameras' axes summed)\n",
+               config.fovea.selection.Strategy().c_str(), 1e3 * sum.select_s / n,
+               travel["pan_deg"].get<double>() / n, travel["tilt_deg"].get<double>() / n,
+               1e3 * travel["carriage_m"].get<double>() / n,
+               travel["motion_time_s"].get<double>() / n);
   return 0;
 }
 

@@ -3,10 +3,12 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -394,6 +396,255 @@ std::string SceneTable(const std::vector<SweepRow>& rows) {
   return h + "\n";
 }
 
+// ---- Strategies: coverage against fixations and motion --------------------
+
+// One run's map after each attempt: fixations done, the loop's cumulative
+// simulated motion, coverage and good coverage; the first point is IDR's map
+// before any fixation.
+struct CurvePoint {
+  int fixations;
+  double motion_s, coverage, good;
+};
+
+std::vector<CurvePoint> RunCurve(const std::string& run_dir, const nlohmann::json& summary) {
+  std::vector<CurvePoint> c = {
+      {0, 0, Num(summary, "idr.coverage"), Num(summary, "idr.good_coverage")}};
+  std::ifstream in(run_dir + "/" + run_folder::kRecords);
+  int done = 0;
+  double motion = 0;
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty()) continue;
+    const nlohmann::json r = nlohmann::json::parse(line);
+    motion += Num(r, "motion_time_s");
+    if (r.value("ok", false)) ++done;
+    c.push_back(
+        {done, motion, Num(r.at("score"), "coverage"), Num(r.at("score"), "good_coverage")});
+  }
+  return c;
+}
+
+// The map's figure (coverage or good) as it stood when `x` (fixations, or
+// motion seconds) was reached: the last point at or before it.
+double CurveAt(const std::vector<CurvePoint>& c, double x, bool by_motion, bool good) {
+  double v = std::nan("");
+  for (const CurvePoint& p : c) {
+    if ((by_motion ? p.motion_s : p.fixations) > x) break;
+    v = good ? p.good : p.coverage;
+  }
+  return v;
+}
+
+// Fixations (or motion seconds) when the figure first reached `level`; NaN if never.
+double Reached(const std::vector<CurvePoint>& c, double level, bool by_motion, bool good) {
+  for (const CurvePoint& p : c)
+    if ((good ? p.good : p.coverage) >= level) return by_motion ? p.motion_s : p.fixations;
+  return std::nan("");
+}
+
+struct Spread {
+  double mean = std::nan(""), sd = std::nan("");
+  int n = 0;
+};
+
+Spread SpreadOf(const std::vector<double>& v) {
+  Spread s;
+  double sum = 0, sum2 = 0;
+  for (const double x : v)
+    if (std::isfinite(x)) sum += x, sum2 += x * x, ++s.n;
+  if (s.n == 0) return s;
+  s.mean = sum / s.n;
+  s.sd = s.n > 1 ? std::sqrt(std::max(0.0, (sum2 - s.n * s.mean * s.mean) / (s.n - 1))) : 0.0;
+  return s;
+}
+
+// A strategy's runs.
+struct StrategyRuns {
+  std::vector<const SweepRow*> rows;
+  std::vector<std::vector<CurvePoint>> curves;
+};
+
+std::string StrategySection(const std::string& dir, const std::vector<SweepRow>& rows) {
+  static const char* kAxis = "selection.strategy";
+  std::map<std::string, StrategyRuns> by;
+  std::vector<std::string> order;
+  int max_fixations = 0;
+  double max_motion = 0;
+  for (const SweepRow& r : rows) {
+    const auto it = r.point.find(kAxis);
+    if (it == r.point.end() || r.variant != "fovea") continue;
+    if (!by.count(it->second)) order.push_back(it->second);
+    StrategyRuns& s = by[it->second];
+    s.rows.push_back(&r);
+    s.curves.push_back(RunCurve(dir + "/runs/" + r.id, r.summary));
+    max_fixations = std::max(max_fixations, s.curves.back().back().fixations);
+    max_motion = std::max(max_motion, s.curves.back().back().motion_s);
+  }
+  if (order.empty()) return "";
+  // Mean curves with a band of one standard deviation over the runs.
+  auto curves = [&](bool by_motion, bool good) {
+    std::vector<Series> series;
+    const int steps = 20;
+    const double x_max = by_motion ? max_motion : max_fixations;
+    for (const std::string& name : order) {
+      Series s{name};
+      for (int k = 0; k <= steps; ++k) {
+        const double x = x_max * k / steps;
+        std::vector<double> v;
+        for (const auto& c : by[name].curves) v.push_back(CurveAt(c, x, by_motion, good));
+        const Spread sp = SpreadOf(v);
+        s.x.push_back(x);
+        s.y.push_back(sp.mean);
+        s.y_lo.push_back(sp.mean - sp.sd);
+        s.y_hi.push_back(sp.mean + sp.sd);
+      }
+      series.push_back(s);
+    }
+    return series;
+  };
+  std::string plots;
+  const struct {
+    bool by_motion, good;
+    const char *file, *title, *xlabel;
+  } kPlots[] = {{false, false, "strategies_coverage_vs_fixations.png", "Coverage against fixations",
+                 "fixations"},
+                {false, true, "strategies_good_vs_fixations.png", "Good coverage against fixations",
+                 "fixations"},
+                {true, false, "strategies_coverage_vs_motion.png", "Coverage against motion time",
+                 "simulated motion of the fixation loop, s"},
+                {true, true, "strategies_good_vs_motion.png", "Good coverage against motion time",
+                 "simulated motion of the fixation loop, s"}};
+  for (const auto& p : kPlots) {
+    const std::vector<Series> series = curves(p.by_motion, p.good);
+    const std::string ylabel = p.good ? "good coverage" : "coverage";
+    plots += GnuplotSvg(p.title, p.xlabel, ylabel, series);
+    // Also a picture of its own, for pages that show pictures (the README).
+    GnuplotPng(dir + "/" + p.file, p.title, p.xlabel, ylabel, series);
+  }
+  // The table: a row per strategy, means over its runs.
+  struct Column {
+    std::string label;
+    std::function<double(const SweepRow&, const std::vector<CurvePoint>&)> value;
+  };
+  std::vector<Column> columns;
+  for (const bool good : {false, true})
+    for (const double level : {0.90, 0.95})
+      for (const bool by_motion : {false, true})
+        columns.push_back({std::string(by_motion ? "motion s" : "fixations") + " to " +
+                               Fmt(100 * level, "%.0f") + "% " +
+                               (good ? "good coverage" : "coverage"),
+                           [=](const SweepRow&, const std::vector<CurvePoint>& c) {
+                             return Reached(c, level, by_motion, good);
+                           }});
+  columns.push_back({"final coverage", [](const SweepRow& r, const std::vector<CurvePoint>&) {
+                       return Num(r.summary, "coverage");
+                     }});
+  columns.push_back({"final good coverage", [](const SweepRow& r, const std::vector<CurvePoint>&) {
+                       return Num(r.summary, "good_coverage");
+                     }});
+  columns.push_back({"fixations done", [](const SweepRow& r, const std::vector<CurvePoint>&) {
+                       return Num(r.summary, "fixations");
+                     }});
+  columns.push_back({"refused share", [](const SweepRow& r, const std::vector<CurvePoint>&) {
+                       return Num(r.summary, "refused") / std::max(1.0, Num(r.summary, "attempts"));
+                     }});
+  columns.push_back(
+      {"motion s per fixation", [](const SweepRow& r, const std::vector<CurvePoint>&) {
+         return Num(r.summary, "travel.motion_time_s") / std::max(1.0, Num(r.summary, "fixations"));
+       }});
+  columns.push_back({"pan deg per fixation", [](const SweepRow& r, const std::vector<CurvePoint>&) {
+                       return Num(r.summary, "travel.pan_deg") /
+                              std::max(1.0, Num(r.summary, "fixations"));
+                     }});
+  columns.push_back(
+      {"tilt deg per fixation", [](const SweepRow& r, const std::vector<CurvePoint>&) {
+         return Num(r.summary, "travel.tilt_deg") / std::max(1.0, Num(r.summary, "fixations"));
+       }});
+  columns.push_back(
+      {"carriage mm per fixation", [](const SweepRow& r, const std::vector<CurvePoint>&) {
+         return 1e3 * Num(r.summary, "travel.carriage_m") /
+                std::max(1.0, Num(r.summary, "fixations"));
+       }});
+  columns.push_back(
+      {"selection ms per fixation", [](const SweepRow& r, const std::vector<CurvePoint>&) {
+         return 1e3 * Num(r.summary, "time_s.select") / std::max(1.0, Num(r.summary, "fixations"));
+       }});
+  std::string html =
+      "<h2>Strategies</h2><p>Means over each strategy's runs (every scene and seed); for the "
+      "figures to reach a level, the mean over the runs that reached it, and how many did. Motion "
+      "is the fixation loop's simulated motion (IDR's, the same for every strategy, left out). "
+      "Curves: the mean with a band of one standard deviation over the runs.</p><table><tr><th "
+      "class=l>strategy</th><th>runs</th>";
+  std::string md = "| strategy | runs |";
+  std::string md_rule = "|---|---|";
+  for (const Column& c : columns) {
+    html += "<th>" + Html(c.label) + "</th>";
+    md += " " + c.label + " |";
+    md_rule += "---|";
+  }
+  html += "</tr>\n";
+  md += "\n" + md_rule + "\n";
+  for (const std::string& name : order) {
+    const StrategyRuns& s = by[name];
+    const std::string n = std::to_string(s.rows.size());
+    html += "<tr><td class=l>" + Html(name) + "</td><td>" + n + "</td>";
+    md += "| " + name + " | " + n + " |";
+    for (size_t k = 0; k < columns.size(); ++k) {
+      std::vector<double> v;
+      for (size_t i = 0; i < s.rows.size(); ++i)
+        v.push_back(columns[k].value(*s.rows[i], s.curves[i]));
+      const Spread sp = SpreadOf(v);
+      std::string cell = sp.n ? Fmt(sp.mean, "%.3g") : std::string("-");
+      if (k < 8) cell += " (" + std::to_string(sp.n) + "/" + n + ")";
+      html += "<td>" + Html(cell) + "</td>";
+      md += " " + cell + " |";
+    }
+    html += "</tr>\n";
+    md += "\n";
+  }
+  html += "</table>\n";
+  // Seed-to-seed spread against the difference between strategies, per scene:
+  // each scene's standard deviation over seeds, averaged over scenes.
+  std::string spread =
+      "<h3>Seed-to-seed spread</h3><p>Per scene: the mean and the standard deviation over seeds; "
+      "averaged over scenes. A difference between two strategies smaller than the spread is "
+      "not one.</p><table><tr><th class=l>strategy</th><th>final coverage</th><th>sd over "
+      "seeds</th><th>final good coverage</th><th>sd over seeds</th><th>fixations to 95% "
+      "coverage (runs that reached it)</th><th>sd over seeds</th></tr>\n";
+  std::string md_spread =
+      "\n| strategy | final coverage | sd over seeds | final good coverage | sd over seeds | "
+      "fixations to 95% coverage | sd over seeds |\n|---|---|---|---|---|---|---|\n";
+  for (const std::string& name : order) {
+    const StrategyRuns& s = by[name];
+    std::map<std::string, std::array<std::vector<double>, 3>> per_scene;
+    for (size_t i = 0; i < s.rows.size(); ++i) {
+      auto& v = per_scene[s.rows[i]->scene];
+      v[0].push_back(Num(s.rows[i]->summary, "coverage"));
+      v[1].push_back(Num(s.rows[i]->summary, "good_coverage"));
+      v[2].push_back(Reached(s.curves[i], 0.95, false, false));
+    }
+    std::array<std::vector<double>, 3> means, sds;
+    for (const auto& [scene, v] : per_scene)
+      for (int k = 0; k < 3; ++k) {
+        const Spread sp = SpreadOf(v[k]);
+        means[k].push_back(sp.mean);
+        if (sp.n > 1) sds[k].push_back(sp.sd);
+      }
+    spread += "<tr><td class=l>" + Html(name) + "</td>";
+    md_spread += "| " + name + " |";
+    for (int k = 0; k < 3; ++k) {
+      auto text = [](const Spread& sp) { return sp.n ? Fmt(sp.mean, "%.3g") : std::string("-"); };
+      const std::string m = text(SpreadOf(means[k])), sd = text(SpreadOf(sds[k]));
+      spread += "<td>" + m + "</td><td>" + sd + "</td>";
+      md_spread += " " + m + " | " + sd + " |";
+    }
+    spread += "</tr>\n";
+    md_spread += "\n";
+  }
+  spread += "</table>\n";
+  WriteTextAtomic(dir + "/strategies.md", md + md_spread);
+  return html + spread + "<div class=plots>" + plots + "</div>\n";
+}
+
 std::string SweepReport(const std::string& dir) {
   const nlohmann::json grid = ReadJson(dir + "/grid.json");
   int missing = 0;
@@ -419,18 +670,24 @@ std::string SweepReport(const std::string& dir) {
        " (static_sgbm: StereoSGBM on the static parallel pair; deterministic: always the "
        "composite's "
        "maximum).</p>\n";
-  return h + SceneTable(rows) + AxisPlots(grid, rows) + RunsTable(grid, rows) + "</body></html>\n";
+  return h + StrategySection(dir, rows) + SceneTable(rows) + AxisPlots(grid, rows) +
+         RunsTable(grid, rows) + "</body></html>\n";
 }
 
 }  // namespace
 
-std::string GnuplotSvg(const std::string& title, const std::string& xlabel,
-                       const std::string& ylabel, const std::vector<Series>& series, bool log_y) {
+namespace {
+
+// Runs gnuplot on the plot, drawn by `terminal` into `output`; throws with
+// gnuplot's first line of complaint.
+void RunGnuplot(const std::string& terminal, const std::string& output, const std::string& title,
+                const std::string& xlabel, const std::string& ylabel,
+                const std::vector<Series>& series, bool log_y) {
   const std::string base =
       (fs::temp_directory_path() / ("fovea_plot_" + std::to_string(getpid()))).string();
   std::ostringstream gp;
-  gp << "set terminal svg size 560,380 fixed noenhanced font 'sans,11' background rgb 'white'\n"
-     << "set output " << Quoted(base + ".svg") << "\n"
+  gp << "set terminal " << terminal << "\n"
+     << "set output " << Quoted(output) << "\n"
      << "set title " << Quoted(title) << "\nset xlabel " << Quoted(xlabel) << "\nset ylabel "
      << Quoted(ylabel)
      << "\nset key outside below\nset grid\nset offsets graph 0.03, graph 0.03, graph 0.05, graph "
@@ -460,15 +717,48 @@ std::string GnuplotSvg(const std::string& title, const std::string& xlabel,
   }
   const std::string cmd = "gnuplot " + base + ".gp 2>" + base + ".err";
   const int status = std::system(cmd.c_str());
-  const std::string svg = ReadFile(base + ".svg");
   const std::string err = ReadFile(base + ".err");
   std::error_code ec;
-  for (const char* ext : {".gp", ".svg", ".err"}) fs::remove(base + ext, ec);
-  if (status != 0 || svg.empty())
+  for (const char* ext : {".gp", ".err"}) fs::remove(base + ext, ec);
+  if (status != 0 || !fs::exists(output) || fs::file_size(output, ec) == 0)
     throw std::runtime_error("gnuplot failed (is it installed? apt-get install gnuplot-nox): " +
                              err.substr(0, err.find('\n')));
+}
+
+}  // namespace
+
+std::string GnuplotSvg(const std::string& title, const std::string& xlabel,
+                       const std::string& ylabel, const std::vector<Series>& series, bool log_y) {
+  const std::string svg_path =
+      (fs::temp_directory_path() / ("fovea_plot_" + std::to_string(getpid()) + ".svg")).string();
+  std::error_code ec;
+  fs::remove(svg_path, ec);
+  try {
+    RunGnuplot("svg size 560,380 fixed noenhanced font 'sans,11' background rgb 'white'", svg_path,
+               title, xlabel, ylabel, series, log_y);
+  } catch (...) {
+    fs::remove(svg_path, ec);
+    throw;
+  }
+  const std::string svg = ReadFile(svg_path);
+  fs::remove(svg_path, ec);
   const size_t start = svg.find("<svg");
   return "<div>" + (start == std::string::npos ? svg : svg.substr(start)) + "</div>\n";
+}
+
+void GnuplotPng(const std::string& path, const std::string& title, const std::string& xlabel,
+                const std::string& ylabel, const std::vector<Series>& series, bool log_y) {
+  // Drawn beside the target, then renamed: a whole picture or none.
+  const std::string part = path + ".part.png";
+  try {
+    RunGnuplot("pngcairo size 720,480 noenhanced font 'sans,10' background rgb 'white'", part,
+               title, xlabel, ylabel, series, log_y);
+    fs::rename(part, path);
+  } catch (...) {
+    std::error_code ec;
+    fs::remove(part, ec);
+    throw;
+  }
 }
 
 std::string WriteReport(const std::string& dir) {

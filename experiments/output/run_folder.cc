@@ -108,6 +108,11 @@ nlohmann::json FoveaSizesJson(const std::vector<fovea::FixationRecord>& records)
   return j;
 }
 
+nlohmann::json TravelJson(double pan_rad, double tilt_rad, double carriage_m) {
+  constexpr double kDeg = 180 / M_PI;
+  return {{"pan_deg", kDeg * pan_rad}, {"tilt_deg", kDeg * tilt_rad}, {"carriage_m", carriage_m}};
+}
+
 nlohmann::json RecordJson(const fovea::FixationRecord& r, const MapScore& score) {
   nlohmann::json j;
   j["attempt"] = r.attempt;
@@ -117,6 +122,7 @@ nlohmann::json RecordJson(const fovea::FixationRecord& r, const MapScore& score)
   j["selection"] = SelectionJson(r.selection);
   j["target_W"] = Vec(r.target_W);
   j["motion_time_s"] = r.motion_time_s;
+  j["travel"] = TravelJson(r.pan_rad, r.tilt_rad, r.carriage_m);
   j["time_s"] = {{"select", r.time.select_s},    {"verge", r.time.verge_s},
                  {"servo_wall", r.time.servo_s}, {"foveal", r.time.foveal_s},
                  {"match", r.time.match_s},      {"integrate", r.time.integrate_s}};
@@ -155,11 +161,32 @@ Recorder::Recorder(const std::string& dir, const std::string& scene_path, const 
   snapshots_.push_back(fixations_);
 }
 
+nlohmann::json Recorder::SurfaceAt(const Eigen::Vector3d& p_W) const {
+  // The nearest hit among the ray from the reference camera through the
+  // point (both ways) and the rays from the point along the six axis
+  // directions: a point on a surface, a few millimetres off it, or past an
+  // edge that the reference ray grazes.
+  const Eigen::Vector3d eye = ref_.view.world_T_camera.translation();
+  const Eigen::Vector3d to_point = (p_W - eye).normalized();
+  std::vector<Eigen::Vector3d> directions = {to_point, -to_point};
+  for (int a = 0; a < 3; ++a)
+    for (const double sign : {1.0, -1.0}) directions.push_back(sign * Eigen::Vector3d::Unit(a));
+  std::optional<sim::RayHit> nearest;
+  for (const Eigen::Vector3d& d : directions)
+    if (const auto hit = truth_.CastRay(p_W, d);
+        hit && (!nearest || hit->distance_m < nearest->distance_m))
+      nearest = hit;
+  if (!nearest) return {{"name", nullptr}, {"distance_m", nullptr}};
+  return {{"name", truth_.GeomName(nearest->geom_id)}, {"distance_m", nearest->distance_m}};
+}
+
 void Recorder::operator()(const fovea::FixationRecord& r, const fovea::PatchMap& map) {
   auto t = fovea::Clock::now();
   const MapScore score = ScoreMap(map, ref_, truth_, baseline_m_, false);
   scoring_s += fovea::Since(t);
-  jsonl_ += RecordJson(r, score).dump() + "\n";
+  nlohmann::json record = RecordJson(r, score);
+  if (r.ok) record["surface"] = SurfaceAt(r.fixation_W);
+  jsonl_ += record.dump() + "\n";
   if (r.ok)
     path_.push_back(r.fixation_W);
   else

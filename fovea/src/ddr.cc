@@ -1,10 +1,12 @@
 #include "fovea/ddr.h"
 
+#include <cmath>
 #include <stdexcept>
 
 #include "fovea/geometry.h"
 #include "fovea/params.h"
 #include "fovea/stats.h"
+#include "fovea/strategy.h"
 #include "fovea/timing.h"
 
 namespace fovea {
@@ -69,36 +71,50 @@ struct LoopState {
   std::vector<double> share_history;
 };
 
-// The next target: IDR's point first, then the selector's choice in the
-// current view. With prescreen_holes, a hole whose window has no unique
-// match along its ray in the current pair is passed over without a move
-// (and its neighbourhood with it, as a refused point's), up to
+// The next target: the strategy's choice, in the current view or the
+// reference view as it asks (with selection.first_fixation "idr", IDR's
+// point first). With prescreen_holes, a hole whose window has no unique
+// match along its ray in the pair it was chosen in is passed over without a
+// move (and its neighbourhood with it, as a refused point's), up to
 // kMaxPrescreened times.
-SelectionSummary ChooseTarget(const FoveaRun& run, LoopState& state,
-                              const FixationSelector& selector, const FoveaOptions& options,
-                              const DepthRange& hole_depths, int attempt, std::mt19937_64* rng) {
-  if (attempt == 1) {
+SelectionSummary ChooseTarget(const FoveaRun& run, LoopState& state, FixationStrategy& strategy,
+                              const FoveaOptions& options, const DepthRange& hole_depths,
+                              int attempt, std::mt19937_64* rng) {
+  if (attempt == 1 && options.selection.first_fixation == "idr") {
     SelectionSummary first;
     first.ok = true;
     first.point_W = run.idr.first_fixation_W;
     return first;
   }
-  const rig::CameraView& view = state.frame.left;
+  const bool in_reference = strategy.View() == StrategyView::kReference;
+  const rig::StereoFrame& frame = in_reference ? run.idr.final_frame : state.frame;
+  const rig::CameraView& view = frame.left;
   SelectionContext context = SelectionContext::Make(view.gray, view, run.map, options.fixate_holes);
+  context.eye_W = state.frame.left.world_T_camera;
   context.has_fixation = state.has_fixation;
   context.fixation_depth_m = state.current.fixation_depth_m;
   context.z_t_near_m = state.current.z_t_near_m;
   context.z_t_far_m = state.current.z_t_far_m;
   context.visits = state.visits;
-  if (options.stay_in_idr_view) context.region = run.idr.final_frame.left;
+  if (options.stay_in_idr_view && !in_reference) context.region = run.idr.final_frame.left;
   constexpr int kMaxPrescreened = 8;
   for (int i = 0;; ++i) {
-    SelectionSummary s = selector.Choose(context, run.map, state.refused, rng);
+    SelectionSummary s = strategy.Choose(context, run.map, state.refused, rng);
     s.prescreened = i;
     if (!s.ok || !s.in_hole || !options.prescreen_holes || i == kMaxPrescreened ||
-        UniqueAlongRay(state.frame, s.pixel, hole_depths, options.fixation.servo))
+        UniqueAlongRay(frame, s.pixel, hole_depths, options.fixation.servo))
       return s;
     state.refused.push_back(s.point_W);
+  }
+}
+
+// Total travel of each kind of axis between two stage states, both cameras
+// summed.
+void AddTravel(const rig::StageState& from, const rig::StageState& to, FixationRecord* rec) {
+  for (const rig::Side side : {rig::Side::kLeft, rig::Side::kRight}) {
+    rec->pan_rad += std::abs(to[side].pan_rad - from[side].pan_rad);
+    rec->tilt_rad += std::abs(to[side].tilt_rad - from[side].tilt_rad);
+    rec->carriage_m += std::abs(to[side].carriage_m - from[side].carriage_m);
   }
 }
 
@@ -169,13 +185,14 @@ FoveaRun RunFovea(rig::Rig& rig, const StereoMatcher& matcher, const FoveaOption
   options.Check();  // once: nothing below checks again
   FoveaRun run;
   std::mt19937_64 rng(options.seed);
-  const FixationSelector selector(options.criteria.Make(), options.selection);
+  const std::unique_ptr<FixationStrategy> strategy =
+      MakeStrategy(options.selection, options.criteria);
   const FixationOptions fixation_options = ResolvedFixationOptions(options);
   run.idr = RunIdr(rig, options.idr);
   run.map = run.idr.map;
   run.motion_time_s = run.idr.motion_time_s;
   run.compute_time_s = run.idr.compute_time_s;
-  if (!run.idr.has_fixation) {
+  if (options.selection.first_fixation == "idr" && !run.idr.has_fixation) {
     run.stop_reason = "IDR found no point to fixate";
     return run;
   }
@@ -198,7 +215,7 @@ FoveaRun RunFovea(rig::Rig& rig, const StereoMatcher& matcher, const FoveaOption
     FixationRecord rec;
     rec.attempt = attempt;
     auto t = Clock::now();
-    rec.selection = ChooseTarget(run, state, selector, options, hole_depths, attempt, &rng);
+    rec.selection = ChooseTarget(run, state, *strategy, options, hole_depths, attempt, &rng);
     rec.time.select_s = Since(t);
     if (!rec.selection.ok) {
       rec.why = rec.selection.why;
@@ -211,8 +228,10 @@ FoveaRun RunFovea(rig::Rig& rig, const StereoMatcher& matcher, const FoveaOption
     // every depth the scene allows.
     const std::optional<DepthRange> guessed =
         rec.selection.in_hole ? std::optional<DepthRange>(hole_depths) : std::nullopt;
+    const rig::StageState before = rig.State();
     const FixationResult r = Fixate(rig, run.map, rec.target_W, matcher, fixation_options,
                                     run.fixations_done + 1, guessed);
+    AddTravel(before, rig.State(), &rec);
     rec.time.verge_s = r.verge_time_s;
     rec.time.servo_s = r.servo_wall_s;
     rec.motion_time_s = r.motion_time_s;

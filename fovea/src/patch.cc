@@ -174,11 +174,15 @@ double RayTriangle(const Eigen::Vector3d& o, const Eigen::Vector3d& d, const Eig
   if (std::abs(det) < 1e-15) return -1;
   const double inv = 1.0 / det;
   const Eigen::Vector3d t = o - a;
+  // Edges are closed with a margin for rounding: a ray through the diagonal
+  // two triangles of a quad share (or an edge two patches share) must hit
+  // one of them, not slip between both.
+  constexpr double kEdge = 1e-9;
   const double u = t.dot(p) * inv;
-  if (u < 0 || u > 1) return -1;
+  if (u < -kEdge || u > 1 + kEdge) return -1;
   const Eigen::Vector3d q = t.cross(e1);
   const double v = d.dot(q) * inv;
-  if (v < 0 || u + v > 1) return -1;
+  if (v < -kEdge || u + v > 1 + kEdge) return -1;
   const double dist = e2.dot(q) * inv;
   return dist > 0 ? dist : -1;
 }

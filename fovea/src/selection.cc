@@ -16,7 +16,8 @@ SelectionContext SelectionContext::Make(const cv::Mat& image, const rig::CameraV
   SelectionContext c;
   c.image = image;
   c.view = view;
-  cv::Mat ids;
+  c.eye_W = view.world_T_camera;
+  cv::Mat& ids = c.map_id;
   map.Render(view.world_T_camera, view.intrinsics, &c.map_depth_m, &ids);
   c.map_level = cv::Mat(ids.size(), CV_8S, cv::Scalar(-1));
   for (int y = 0; y < ids.rows; ++y)
@@ -168,6 +169,14 @@ cv::Mat Proximity3D::Evaluate(const SelectionContext& c) const {
 }
 
 void SelectionOptions::Check() const {
+  rig::CheckParam(params::kSelectionStrategy, strategy);
+  rig::CheckParam(params::kSelectionFirstFixation, first_fixation);
+  if (deterministic && strategy != "fovea" && strategy != "deterministic")
+    throw rig::InputError("key 'selection.deterministic': true applies to strategy fovea, not '" +
+                          strategy + "'");
+  rig::CheckParam(params::kSelectionFoveaSizePx, fovea_size_px);
+  rig::CheckParam(params::kSelectionMotionWeight, motion_weight);
+  rig::CheckParam(params::kSelectionHalfKnownRelSigma, half_known_rel_sigma);
   rig::CheckParam(params::kSelectionDrawScale, draw_scale);
   rig::CheckParam(params::kSelectionHistogramBins, histogram_bins);
   rig::CheckParam(params::kSelectionBorderPx, border_px);
@@ -199,6 +208,41 @@ FixationSelector::FixationSelector(std::vector<std::shared_ptr<const FixationCri
   options_.Check();
 }
 
+cv::Mat Candidates(const SelectionContext& c, const std::vector<Eigen::Vector3d>& refused_W,
+                   const SelectionOptions& options) {
+  cv::Mat candidates(c.map_depth_m.size(), CV_8U, cv::Scalar(0));
+  const int b = options.border_px;
+  for (int y = b; y < candidates.rows - b; ++y)
+    for (int x = b; x < candidates.cols - b; ++x) {
+      if (!(c.map_depth_m.at<float>(y, x) > 0)) continue;
+      if (c.region) {
+        const Eigen::Vector3d p_W = c.MapPoint(x, y);
+        const auto uv = ProjectWorldPoint(c.region->world_T_camera, c.region->intrinsics, p_W);
+        const auto& k = c.region->intrinsics;
+        if (!uv || uv->x() < b || uv->y() < b || uv->x() > k.width_px - 1 - b ||
+            uv->y() > k.height_px - 1 - b)
+          continue;
+      }
+      candidates.at<uchar>(y, x) = 255;
+    }
+  ClearNear(c, refused_W, options.refused_radius_m, &candidates);
+  return candidates;
+}
+
+void ClearNear(const SelectionContext& c, const std::vector<Eigen::Vector3d>& points_W,
+               double radius_m, cv::Mat* candidates) {
+  // Each point visits only the pixels it can reach (a pixel already out stays
+  // out): the cost does not grow with the points.
+  for (const Eigen::Vector3d& r : points_W) {
+    const cv::Rect box = PixelsNear(c.view, r, radius_m);
+    for (int y = box.y; y < box.y + box.height; ++y)
+      for (int x = box.x; x < box.x + box.width; ++x) {
+        uchar& v = candidates->at<uchar>(y, x);
+        if (v && (c.MapPoint(x, y) - r).norm() < radius_m) v = 0;
+      }
+  }
+}
+
 cv::Mat FixationSelector::Composite(const SelectionContext& c,
                                     const std::vector<Eigen::Vector3d>& refused_W,
                                     std::vector<cv::Mat>* each) const {
@@ -209,35 +253,9 @@ cv::Mat FixationSelector::Composite(const SelectionContext& c,
     composite = composite.mul(w);
     if (each) each->push_back(w);
   }
-  // Only pixels the map can raytrace, away from the border and from refused points.
-  const int b = options_.border_px;
-  for (int y = 0; y < composite.rows; ++y)
-    for (int x = 0; x < composite.cols; ++x) {
-      double& v = composite.at<double>(y, x);
-      const float z = c.map_depth_m.at<float>(y, x);
-      if (z <= 0 || x < b || y < b || x >= composite.cols - b || y >= composite.rows - b) {
-        v = 0;
-        continue;
-      }
-      if (!c.region) continue;
-      const Eigen::Vector3d p_W = c.MapPoint(x, y);
-      const auto uv = ProjectWorldPoint(c.region->world_T_camera, c.region->intrinsics, p_W);
-      const auto& k = c.region->intrinsics;
-      if (!uv || uv->x() < b || uv->y() < b || uv->x() > k.width_px - 1 - b ||
-          uv->y() > k.height_px - 1 - b)
-        v = 0;
-    }
-  // Each refused point clears the pixels near it, visiting only those it can
-  // reach (a pixel already at 0 stays there): the cost does not grow with the
-  // attempts refused.
-  for (const Eigen::Vector3d& r : refused_W) {
-    const cv::Rect box = PixelsNear(c.view, r, options_.refused_radius_m);
-    for (int y = box.y; y < box.y + box.height; ++y)
-      for (int x = box.x; x < box.x + box.width; ++x) {
-        double& v = composite.at<double>(y, x);
-        if (v != 0 && (c.MapPoint(x, y) - r).norm() < options_.refused_radius_m) v = 0;
-      }
-  }
+  // Only the candidates: pixels the map can raytrace, away from the border
+  // and from refused points.
+  composite.setTo(0.0, Candidates(c, refused_W, options_) == 0);
   NormalizeSum(&composite);
   return composite;
 }
@@ -266,7 +284,8 @@ SelectionSummary FixationSelector::Choose(const SelectionContext& c, const Patch
   const int bins = options_.histogram_bins;
   auto bin_of = [&](double v) { return std::min(bins - 1, static_cast<int>(v / c_max * bins)); };
   int chosen_bin;
-  if (options_.deterministic) {
+  const bool deterministic = options_.Strategy() == "deterministic";
+  if (deterministic) {
     chosen_bin = bins - 1;
     s.drawn_value = c_max;
   } else {
@@ -299,33 +318,41 @@ SelectionSummary FixationSelector::Choose(const SelectionContext& c, const Patch
       const double v = composite.at<double>(y, x);
       if (v <= 0) continue;
       const double d = centre_dist(x, y);
-      const bool better = options_.deterministic
-                              ? (v > best_value || (v == best_value && d < best_dist))
-                              : (bin_of(v) == chosen_bin && d < best_dist);
+      const bool better = deterministic ? (v > best_value || (v == best_value && d < best_dist))
+                                        : (bin_of(v) == chosen_bin && d < best_dist);
       if (better) best_value = v, best_dist = d, bx = x, by = y;
     }
-  s.pixel = Eigen::Vector2d(bx, by);
   s.composite_chosen = composite.at<double>(by, bx);
-  const Ray ray = PixelRay(c.view.world_T_camera, c.view.intrinsics, s.pixel);
-  const auto hit = map.CastRay(ray.origin_W, ray.direction_W);
-  if (hit) {
-    s.point_W = ray.origin_W + hit->distance_m * ray.direction_W;
-  } else if (c.map_level.at<signed char>(by, bx) < 0) {
-    // A hole the context filled (see SelectionContext::Make): its guessed depth.
-    s.point_W = c.MapPoint(bx, by);
-    s.in_hole = true;
-  } else {
-    s.why = "the chosen pixel's ray misses the map";
-    return s;
-  }
+  AimAt(c, map, bx, by, &s);
+  if (!s.ok) return s;
   const cv::Mat candidates = composite > 0;
   for (size_t i = 0; i < criteria_.size(); ++i) {
     const double mean = cv::mean(each[i], candidates)[0];
     s.criteria.emplace_back(criteria_[i]->Name(),
                             mean > 0 ? each[i].at<double>(by, bx) / mean : 0.0);
   }
-  s.ok = true;
   return s;
+}
+
+void AimAt(const SelectionContext& c, const PatchMap& map, int x, int y, SelectionSummary* s) {
+  s->pixel = Eigen::Vector2d(x, y);
+  const Ray ray = PixelRay(c.view.world_T_camera, c.view.intrinsics, s->pixel);
+  const auto hit = map.CastRay(ray.origin_W, ray.direction_W);
+  if (hit) {
+    s->point_W = ray.origin_W + hit->distance_m * ray.direction_W;
+  } else if (c.map_level.at<signed char>(y, x) < 0) {
+    // A hole the context filled (see SelectionContext::Make): its guessed depth.
+    s->point_W = c.MapPoint(x, y);
+    s->in_hole = true;
+  } else {
+    s->why = "the chosen pixel's ray misses the map";
+    return;
+  }
+  s->ok = true;
+}
+
+std::string SelectionOptions::Strategy() const {
+  return deterministic ? "deterministic" : strategy;
 }
 
 }  // namespace fovea

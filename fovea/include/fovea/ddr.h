@@ -102,6 +102,10 @@ struct FixationRecord {
   std::array<int, 3> map_by_level{0, 0, 0};
   double foveal_share = 0;  ///< map's foveal share of the IDR view, as the loop sees it
   double motion_time_s = 0;
+  /// The attempt's stage travel, from the state before it to the state after
+  /// it, summed over both cameras: pan and tilt in radians, carriages in
+  /// metres.
+  double pan_rad = 0, tilt_rad = 0, carriage_m = 0;
   StageTimes time;
 };
 

@@ -224,6 +224,35 @@ inline constexpr ParamSpec kSgbmSpeckleRange{
     "sgbm.speckle_range", "StereoSGBM matcher: speckle filter disparity range", 0, 64};
 
 // ---- DDR: selection, criteria, integration, the loop (paper IV) -----------
+inline constexpr const char* kSelectionStrategies[] = {"fovea",  "deterministic",  "random",
+                                                       "raster", "next_best_view", nullptr};
+inline constexpr ParamSpec kSelectionStrategy{
+    "selection.strategy",
+    "where to look next: fovea (the paper's composite criteria and exponential draw), "
+    "deterministic (the composite's maximum), random (uniform over the reference view's "
+    "candidates), raster (a fixed scan of the reference view in fovea-sized cells), "
+    "next_best_view (the most unmapped or uncertain fovea-sized window, less a motion cost)",
+    0, 0, kSelectionStrategies};
+inline constexpr const char* kSelectionFirstFixations[] = {"ddr", "idr", nullptr};
+inline constexpr ParamSpec kSelectionFirstFixation{
+    "selection.first_fixation",
+    "the first fixation: ddr (chosen by the strategy in IDR's final view, as in the paper) or idr "
+    "(IDR's well-supported patch nearest the view's centre)",
+    0, 0, kSelectionFirstFixations};
+inline constexpr ParamSpec kSelectionFoveaSizePx{
+    "selection.fovea_size_px",
+    "the fovea's size in the reference view: raster's cell and next_best_view's window, pixels", 8,
+    1024};
+inline constexpr ParamSpec kSelectionMotionWeight{
+    "selection.motion_weight",
+    "next_best_view: information (unmapped share of the window) given up per radian the left "
+    "camera turns",
+    0, 100};
+inline constexpr ParamSpec kSelectionHalfKnownRelSigma{
+    "selection.half_known_rel_sigma",
+    "next_best_view: a mapped pixel whose depth sigma is this share of its depth counts as half "
+    "unknown",
+    1e-6, 1};
 inline constexpr ParamSpec kSelectionDeterministic{
     "selection.deterministic", "always fixate the composite's maximum instead of drawing"};
 inline constexpr ParamSpec kSelectionDrawScale{"selection.draw_scale",

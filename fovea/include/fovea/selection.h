@@ -26,7 +26,12 @@ struct SelectionContext {
   /// pixels the map is silent at carry the depth of the nearest mapped pixel
   /// (map_level stays -1 there).
   cv::Mat map_depth_m;
-  cv::Mat map_level;                     ///< CV_8S: PatchLevel of the patch seen, -1 = none
+  cv::Mat map_level;  ///< CV_8S: PatchLevel of the patch seen, -1 = none
+  cv::Mat map_id;     ///< CV_32S: index in the map of the patch seen, -1 = none
+  /// The current left camera's pose: where the rig looks from now, which
+  /// motion costs are measured from (the view's own pose unless the choice
+  /// is made in another view).
+  Eigen::Isometry3d eye_W = Eigen::Isometry3d::Identity();
   bool has_fixation = false;             ///< false before the first vergent fixation
   double fixation_depth_m = 0;           ///< depth of the current fixation point in the view
   double z_t_near_m = 0, z_t_far_m = 0;  ///< the current fovea's depth band (Z_T)
@@ -147,14 +152,34 @@ class Proximity3D : public FixationCriterion {
 void NormalizeSum(cv::Mat* weights);
 
 struct SelectionOptions {
-  bool deterministic = false;  ///< always take the maximum of the composite
-  double draw_scale = 0.5;     ///< s of the exponential draw
+  /// Which rule chooses (MakeStrategy): "fovea" (the paper's composite and
+  /// exponential draw), "deterministic", "random", "raster",
+  /// "next_best_view".
+  std::string strategy = "fovea";
+  /// Always take the maximum of the composite: the same as strategy
+  /// "deterministic" (kept for the configurations that set it).
+  bool deterministic = false;
+  /// How the first fixation is chosen: "ddr" (by the strategy, in IDR's
+  /// final view, as the paper does) or "idr" (IDR's well-supported patch
+  /// nearest the view's centre).
+  std::string first_fixation = "ddr";
+  double draw_scale = 0.5;  ///< s of the exponential draw
   int histogram_bins = 64;
   int border_px = 16;  ///< candidates keep this far from the image edge
   /// Candidates whose map point lies within this distance of a point that
   /// could not be fixated are left out.
   double refused_radius_m = 0.03;
+  /// The fovea's size in the view, pixels: raster's cell and
+  /// next_best_view's window.
+  int fovea_size_px = 128;
+  /// next_best_view: information given up per radian the left camera turns.
+  double motion_weight = 0.5;
+  /// next_best_view: a mapped pixel whose depth sigma is this share of its
+  /// depth counts as half unknown.
+  double half_known_rel_sigma = 0.002;
   void Check() const;  ///< throws rig::InputError naming the key (fovea/params.h)
+  /// The strategy in force: "deterministic" when `deterministic` is set.
+  std::string Strategy() const;
 };
 
 /// What one choice looked like, for the records.
@@ -173,6 +198,23 @@ struct SelectionSummary {
   /// mean over the candidates (1 = average, > 1 = favoured).
   std::vector<std::pair<std::string, double>> criteria;
 };
+
+/// The pixels a strategy may choose (CV_8U, 255 = candidate): those the map
+/// can raytrace (map_depth_m > 0, filled holes included), at least
+/// `options.border_px` from the edge, inside `context.region` if it is set,
+/// and farther than `options.refused_radius_m` from every refused point.
+cv::Mat Candidates(const SelectionContext& context, const std::vector<Eigen::Vector3d>& refused_W,
+                   const SelectionOptions& options);
+
+/// Clears the candidates whose map point lies within `radius_m` of any of
+/// `points_W`, visiting only the pixels each can reach.
+void ClearNear(const SelectionContext& context, const std::vector<Eigen::Vector3d>& points_W,
+               double radius_m, cv::Mat* candidates);
+
+/// Completes a choice of pixel (x, y): the point its ray meets in the map (or,
+/// in a hole the context filled, the hole's guessed depth) and ok; or why not.
+void AimAt(const SelectionContext& context, const PatchMap& map, int x, int y,
+           SelectionSummary* summary);
 
 /// The composite selection rule over a set of criteria. All randomness comes
 /// from the generator passed in.

@@ -23,6 +23,10 @@ std::string GnuplotSvg(const std::string& title, const std::string& xlabel,
                        const std::string& ylabel, const std::vector<Series>& series,
                        bool log_y = false);
 
+/// The same plot as a PNG picture at `path` (written whole or not at all).
+void GnuplotPng(const std::string& path, const std::string& title, const std::string& xlabel,
+                const std::string& ylabel, const std::vector<Series>& series, bool log_y = false);
+
 /// Writes DIR/report.html for a run folder (summary.json) or a sweep folder
 /// (grid.json and results.csv); returns its path. Throws UsageError when DIR
 /// is neither.

@@ -36,6 +36,9 @@ std::string SnapshotName(int fixation);
 /// configuration.
 bool IsWallClockKey(const std::string& key);
 
+/// Stage travel: {"pan_deg", "tilt_deg", "carriage_m"}, both cameras summed.
+nlohmann::json TravelJson(double pan_rad, double tilt_rad, double carriage_m);
+
 /// One attempt's record (a line of fixations.jsonl).
 nlohmann::json RecordJson(const fovea::FixationRecord& record, const MapScore& score);
 
@@ -64,6 +67,10 @@ class Recorder {
   const std::vector<Eigen::Vector3d>& path() const { return path_; }
   const std::vector<Eigen::Vector3d>& refused() const { return refused_; }
   double scoring_s = 0, output_s = 0;  ///< wall clock spent scoring and writing
+  /// The true surface nearest a point ({"name", "distance_m"}, nulls when
+  /// nothing is near): which surface a fixation landed on, and how far off
+  /// it (a false fixation floats).
+  nlohmann::json SurfaceAt(const Eigen::Vector3d& p_W) const;
 
  private:
   std::string dir_, scene_name_;
