@@ -11,26 +11,8 @@ rm -rf "$work"
 mkdir -p "$work"
 fail() { echo "FAIL: $*" >&2; exit 1; }
 
-# The CSV without its wall-clock columns (wall_time_s, compute_time_s,
-# time_s.*). Fields are split at commas outside double quotes (values such
-# as rig.units "1,2,3,4,5,6" are quoted); plain awk, no gawk needed.
-strip() {
-  awk 'function split_csv(line, f,    n, i, c, start, inq) {
-         n = 0; start = 1; inq = 0
-         for (i = 1; i <= length(line); i++) {
-           c = substr(line, i, 1)
-           if (c == "\"") inq = !inq
-           else if (c == "," && !inq) { f[++n] = substr(line, start, i - start); start = i + 1 }
-         }
-         f[++n] = substr(line, start)
-         return n
-       }
-       { n = split_csv($0, f)
-         if (NR == 1) { columns = n; for (i = 1; i <= n; i++) keep[i] = !(f[i] == "wall_time_s" || f[i] == "compute_time_s" || f[i] ~ /^time_s\./) }
-         if (n != columns) { print "row " NR " has " n " fields, the header " columns > "/dev/stderr"; exit 1 }
-         out = ""; sep = ""; for (i = 1; i <= n; i++) if (keep[i]) { out = out sep f[i]; sep = "," }
-         print out }' "$1"
-}
+# strip FILE: the CSV without its wall-clock columns.
+source "$(dirname "$0")/csv_strip.sh"
 done_runs() { ls "$1"/runs/*/summary.json 2>/dev/null | wc -l; }
 
 echo "== uninterrupted sweep"

@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -320,6 +321,22 @@ void CopyRun(const fs::path& from, const fs::path& runs_dir, const std::string& 
     throw std::runtime_error("cannot write '" + (runs_dir / id).string() + "': " + ec.message());
 }
 
+// Whether `dir` is an existing folder whose every entry is one of `shards`.
+bool OnlyShards(const std::string& dir, const std::vector<std::string>& shards) {
+  std::error_code ec;
+  if (!fs::is_directory(fs::symlink_status(dir, ec))) return false;
+  bool any = false;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
+    any = true;
+    const bool shard = std::any_of(shards.begin(), shards.end(), [&](const std::string& s) {
+      std::error_code eq;
+      return fs::equivalent(e.path(), s, eq);
+    });
+    if (!shard) return false;
+  }
+  return any && !ec;
+}
+
 int Collect(const std::string& dir_arg, const std::vector<std::string>& shards, bool report) {
   const std::string dir = NormalizeOutputPath(dir_arg, "collect DIR");
   for (const std::string& s : shards)
@@ -332,9 +349,10 @@ int Collect(const std::string& dir_arg, const std::vector<std::string>& shards, 
   if (!fs::exists(dir + "/grid.json")) {
     if (shards.empty())
       throw UsageError("'" + rig::ClipForMessage(dir) + "' is not a sweep folder (no grid.json)");
-    // Merging into a new or empty folder only: never into one that holds
-    // something else.
-    CheckOutputTarget(dir, "collect DIR", ExistingOutput::kRefuse);
+    // Merging into a new or empty folder only, or one that holds nothing but
+    // the shards being merged (sweep.sbatch writes them as DIR/shard-I):
+    // never into one that holds something else.
+    if (!OnlyShards(dir, shards)) CheckOutputTarget(dir, "collect DIR", ExistingOutput::kRefuse);
     EnsureDirectory(dir + "/runs");
     WriteTextAtomic(dir + "/grid.json", ReadFile(shards[0] + "/grid.json"));
     if (fs::exists(shards[0] + "/sweep.yaml"))
