@@ -139,8 +139,8 @@ void RecordFixation(const FixationResult& r, FixationRecord* rec) {
 // Merges a fixation's patches into the map (timed as integration) and moves
 // the loop on to the fixation's view.
 void Absorb(const FixationResult& r, const rig::CameraView& idr_view,
-            const IntegrationOptions& integration, FoveaRun* run, LoopState* state,
-            FixationRecord* rec) {
+            const IntegrationOptions& integration, int stall_fixations, FoveaRun* run,
+            LoopState* state, FixationRecord* rec) {
   const auto t = Clock::now();
   state->frame = r.servo.frame;
   rec->integration = Integrate(&run->map, r.foveal.patches, state->frame.left, integration);
@@ -150,7 +150,8 @@ void Absorb(const FixationResult& r, const rig::CameraView& idr_view,
   run->map.BuildIndex();
   rec->time.integrate_s = Since(t);
   rec->map_by_level = run->map.CountByLevel();
-  rec->foveal_share = FovealShare(run->map, idr_view);
+  // Only the stall rule reads it: a render of the whole map per fixation.
+  if (stall_fixations > 0) rec->foveal_share = FovealShare(run->map, idr_view);
   state->has_fixation = true;
   state->visits.push_back({rec->fixation_W, rec->target_W});
   state->current = rec->tessellation;
@@ -244,7 +245,7 @@ FoveaRun RunFovea(rig::Rig& rig, const StereoMatcher& matcher, const FoveaOption
     }
     rec.fixation = ++run.fixations_done;
     RecordFixation(r, &rec);
-    Absorb(r, idr_view, options.integration, &run, &state, &rec);
+    Absorb(r, idr_view, options.integration, options.stall_fixations, &run, &state, &rec);
     record(rec);
     state.share_history.push_back(rec.foveal_share);
     if (Stalled(state.share_history, options)) {
