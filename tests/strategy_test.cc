@@ -99,13 +99,22 @@ TEST_CASE("next_best_view picks the largest reachable unmapped region", "[fovea]
   wide.refused_radius_m = 0.3;  // 45 px at 1 m: the whole of `largest`
   fovea::NextBestViewStrategy nbv_wide(wide, fovea::CriteriaOptions{});
   CHECK(Inside(large, nbv_wide.Choose(c3, three, {refused}, &rng).pixel));
-  // So is one the rig has fixated already.
+  // So is one the rig has fixated already (the fovea there yielded
+  // nothing): its neighbourhood's gain is suppressed, its centre left out.
   fovea::SelectionContext visited = c3;
   visited.visits.push_back({refused, refused});
   fovea::CriteriaOptions far_visits;
   far_visits.suppression_radius_m = 0.3;
   fovea::NextBestViewStrategy nbv_visited(Options(), far_visits);
   CHECK(Inside(large, nbv_visited.Choose(visited, three, {}, &rng).pixel));
+  // And a refused point suppresses the same way, beyond its own small radius.
+  CHECK(Inside(large, nbv_visited.Choose(c3, three, {refused}, &rng).pixel));
+  fovea::SelectionContext revisit = c3;
+  revisit.visits.push_back({refused, refused});
+  fovea::NextBestViewStrategy nbv_near(Options(), fovea::CriteriaOptions{});
+  const Eigen::Vector2d near = nbv_near.Choose(revisit, three, {}, &rng).pixel;
+  CHECK((revisit.MapPoint(int(near.x()), int(near.y())) - refused).norm() >=
+        fovea::CriteriaOptions{}.revisit_radius_m);
 }
 
 TEST_CASE("next_best_view prefers the nearer of two equal regions", "[fovea][strategy]") {

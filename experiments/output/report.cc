@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -526,6 +527,7 @@ std::string StrategySection(const std::string& dir, const std::vector<SweepRow>&
     std::function<double(const SweepRow&, const std::vector<CurvePoint>&)> value;
   };
   std::vector<Column> columns;
+  constexpr size_t kReachColumns = 8;  // the first columns: when a level was reached
   for (const bool good : {false, true})
     for (const double level : {0.90, 0.95})
       for (const bool by_motion : {false, true})
@@ -570,7 +572,9 @@ std::string StrategySection(const std::string& dir, const std::vector<SweepRow>&
        }});
   std::string html =
       "<h2>Strategies</h2><p>Means over each strategy's runs (every scene and seed); for the "
-      "figures to reach a level, the mean over the runs that reached it, and how many did. Motion "
+      "figures to reach a level, the median over all its runs (a run that never reached the "
+      "level counts as beyond the end: \"never\" when half of them did not), and how many "
+      "reached it. Motion "
       "is the fixation loop's simulated motion (IDR's, the same for every strategy, left out). "
       "Curves: the mean with a band of one standard deviation over the runs.</p><table><tr><th "
       "class=l>strategy</th><th>runs</th>";
@@ -594,7 +598,17 @@ std::string StrategySection(const std::string& dir, const std::vector<SweepRow>&
         v.push_back(columns[k].value(*s.rows[i], s.curves[i]));
       const Spread sp = SpreadOf(v);
       std::string cell = sp.n ? Fmt(sp.mean, "%.3g") : std::string("-");
-      if (k < 8) cell += " (" + std::to_string(sp.n) + "/" + n + ")";
+      if (k < kReachColumns) {
+        // The median over every run, a run that never reached the level
+        // counting as beyond the end (a mean over the runs that reached it
+        // would favour a strategy that reaches it rarely).
+        for (double& x : v)
+          if (!std::isfinite(x)) x = std::numeric_limits<double>::infinity();
+        std::sort(v.begin(), v.end());
+        const double median = v.empty() ? std::nan("") : v[(v.size() - 1) / 2];
+        cell = (std::isfinite(median) ? Fmt(median, "%.3g") : std::string("never")) + " (" +
+               std::to_string(sp.n) + "/" + n + ")";
+      }
       html += "<td>" + Html(cell) + "</td>";
       md += " " + cell + " |";
     }

@@ -243,6 +243,20 @@ void ClearNear(const SelectionContext& c, const std::vector<Eigen::Vector3d>& po
   }
 }
 
+void CapNear(const SelectionContext& c, const std::vector<Eigen::Vector3d>& points_W,
+             double radius_m, float cap, cv::Mat* weights) {
+  for (const Eigen::Vector3d& r : points_W) {
+    const cv::Rect box = PixelsNear(c.view, r, radius_m);
+    for (int y = box.y; y < box.y + box.height; ++y)
+      for (int x = box.x; x < box.x + box.width; ++x) {
+        float& w = weights->at<float>(y, x);
+        if (w > cap && c.map_depth_m.at<float>(y, x) > 0 &&
+            (c.MapPoint(x, y) - r).norm() < radius_m)
+          w = cap;
+      }
+  }
+}
+
 cv::Mat FixationSelector::Composite(const SelectionContext& c,
                                     const std::vector<Eigen::Vector3d>& refused_W,
                                     std::vector<cv::Mat>* each) const {

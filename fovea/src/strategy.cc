@@ -149,7 +149,7 @@ SelectionSummary NextBestViewStrategy::Choose(const SelectionContext& c, const P
     visited.push_back(v.settled_W);
     visited.push_back(v.aimed_W);
   }
-  ClearNear(c, visited, visited_radius_m_, &candidates);
+  ClearNear(c, visited, criteria_.revisit_radius_m, &candidates);
   s.candidates = cv::countNonZero(candidates);
   if (s.candidates == 0) {
     s.why = kNoCandidate;
@@ -158,7 +158,12 @@ SelectionSummary NextBestViewStrategy::Choose(const SelectionContext& c, const P
   // The window's mean gain; outside the image counts as nothing to gain.
   cv::Mat information;
   const int k = options_.fovea_size_px;
-  cv::boxFilter(Gain(c, map), information, CV_32F, cv::Size(k, k), cv::Point(-1, -1), true,
+  cv::Mat gain = Gain(c, map);
+  std::vector<Eigen::Vector3d> suppressing = visited;
+  suppressing.insert(suppressing.end(), refused_W.begin(), refused_W.end());
+  CapNear(c, suppressing, criteria_.suppression_radius_m,
+          static_cast<float>(criteria_.suppressed_weight), &gain);
+  cv::boxFilter(gain, information, CV_32F, cv::Size(k, k), cv::Point(-1, -1), true,
                 cv::BORDER_CONSTANT);
   const Eigen::Vector3d eye = c.eye_W.translation(), axis = c.eye_W.linear().col(2);
   const double cx = c.view.intrinsics.cx_px, cy = c.view.intrinsics.cy_px;

@@ -211,6 +211,12 @@ cv::Mat Candidates(const SelectionContext& context, const std::vector<Eigen::Vec
 void ClearNear(const SelectionContext& context, const std::vector<Eigen::Vector3d>& points_W,
                double radius_m, cv::Mat* candidates);
 
+/// Caps at `cap` the weights (CV_32F) of the pixels whose map point lies
+/// within `radius_m` of any of `points_W`, visiting only the pixels each can
+/// reach.
+void CapNear(const SelectionContext& context, const std::vector<Eigen::Vector3d>& points_W,
+             double radius_m, float cap, cv::Mat* weights);
+
 /// Completes a choice of pixel (x, y): the point its ray meets in the map (or,
 /// in a hole the context filled, the hole's guessed depth) and ok; or why not.
 void AimAt(const SelectionContext& context, const PatchMap& map, int x, int y,

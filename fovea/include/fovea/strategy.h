@@ -83,26 +83,30 @@ class RasterStrategy : public FixationStrategy {
 /// (1 where the map is silent; where it is mapped, s^2 / (s^2 + h^2), s its
 /// patch's depth sigma over its depth and h = half_known_rel_sigma; by level
 /// when the sigma is unknown: IDR 1, peripheral 0.5, foveal 0), and angle(p)
-/// the turn of the current left camera's axis to p's map point. Candidates
-/// within criteria.suppression_radius_m of an earlier fixation (where the
-/// servo settled, and the point aimed at) are left out: that fovea's
-/// information was had, or could not be. Ties go to the pixel nearest the
-/// centre. O(pixels) per choice (a box filter).
+/// the turn of the current left camera's axis to p's map point. Local
+/// suppression as the paper's rule has it: within
+/// criteria.suppression_radius_m of an earlier fixation (where the servo
+/// settled, and the point aimed at) or of a refused point the gain is at
+/// most criteria.suppressed_weight (what a fovea there could yield was had,
+/// or could not be: a strip no right camera sees stays unmapped), and
+/// candidates within criteria.revisit_radius_m of an earlier fixation are
+/// left out. Ties go to the pixel nearest the centre. O(pixels + points x
+/// their neighbourhoods) per choice (a box filter).
 class NextBestViewStrategy : public FixationStrategy {
  public:
   NextBestViewStrategy(const SelectionOptions& o, const CriteriaOptions& c)
-      : options_(o), visited_radius_m_(c.suppression_radius_m) {}
+      : options_(o), criteria_(c) {}
   std::string Name() const override { return "next_best_view"; }
   StrategyView View() const override { return StrategyView::kReference; }
   SelectionSummary Choose(const SelectionContext& context, const PatchMap& map,
                           const std::vector<Eigen::Vector3d>& refused_W,
                           std::mt19937_64* rng) override;
-  /// Each pixel's gain (CV_32F, in [0, 1]), as above.
+  /// Each pixel's gain (CV_32F, in [0, 1]), as above, before suppression.
   cv::Mat Gain(const SelectionContext& context, const PatchMap& map) const;
 
  private:
   SelectionOptions options_;
-  double visited_radius_m_;
+  CriteriaOptions criteria_;
 };
 
 }  // namespace fovea
