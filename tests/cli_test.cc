@@ -34,6 +34,13 @@ Result Fovea(const std::string& args) {
   return {WIFEXITED(status) ? WEXITSTATUS(status) : 128, ss.str()};
 }
 
+std::string ReadText(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
 int Lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
 
 fs::path TempDir(const std::string& name) {
@@ -273,6 +280,37 @@ TEST_CASE("a sweep over catalog, generated and numbered random scenes runs", "[c
   int rows = -1;  // the header
   for (std::string line; std::getline(csv, line);) rows += !line.empty();
   CHECK(rows == 2);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("a sweep over selection.strategy gets the report's Strategies section", "[cli][sweep]") {
+  const fs::path dir = TempDir("strategy_sweep");
+  fs::create_directories(dir);
+  std::ofstream(dir / "strategies.yaml")
+      << "config: {loop: {fixations: 2}, score: {compare_static: false}, rig: {width_px: 160, "
+         "height_px: 120}}\n"
+         "axes: {selection.strategy: [fovea, next_best_view], scene: [two_planes]}\n";
+  const Result r = Fovea("sweep " + (dir / "strategies.yaml").string() + " --jobs 2 --out " +
+                         (dir / "out").string());
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const std::string page = ReadText(dir / "out" / "report.html");
+  CHECK(page.find("<h2>Strategies</h2>") != std::string::npos);
+  // A table row per strategy, each over its one run, in strategies.md too.
+  const std::string md = ReadText(dir / "out" / "strategies.md");
+  CHECK(md.find("| fovea | 1 |") != std::string::npos);
+  CHECK(md.find("| next_best_view | 1 |") != std::string::npos);
+  for (const char* png :
+       {"strategies_coverage_vs_fixations.png", "strategies_good_vs_motion.png"}) {
+    INFO(png);
+    CHECK(fs::file_size(dir / "out" / png) > 1000);
+  }
+  // Each run's summary names its strategy and its travel.
+  std::ifstream csv(dir / "out" / "results.csv");
+  std::string header;
+  std::getline(csv, header);
+  CHECK(header.find("selection_strategy") != std::string::npos);
+  CHECK(header.find("travel.pan_deg") != std::string::npos);
   fs::remove_all(dir);
 }
 
