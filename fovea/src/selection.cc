@@ -212,15 +212,19 @@ cv::Mat Candidates(const SelectionContext& c, const std::vector<Eigen::Vector3d>
                    const SelectionOptions& options) {
   cv::Mat candidates(c.map_depth_m.size(), CV_8U, cv::Scalar(0));
   const int b = options.border_px;
+  // ProjectWorldPoint's steps, with the region camera's inverse pose taken
+  // once rather than per pixel.
+  const Eigen::Isometry3d region_T_world =
+      c.region ? c.region->world_T_camera.inverse() : Eigen::Isometry3d::Identity();
   for (int y = b; y < candidates.rows - b; ++y)
     for (int x = b; x < candidates.cols - b; ++x) {
       if (!(c.map_depth_m.at<float>(y, x) > 0)) continue;
       if (c.region) {
-        const Eigen::Vector3d p_W = c.MapPoint(x, y);
-        const auto uv = ProjectWorldPoint(c.region->world_T_camera, c.region->intrinsics, p_W);
+        const Eigen::Vector3d p_C = region_T_world * c.MapPoint(x, y);
+        if (!(p_C.z() > 1e-9)) continue;
         const auto& k = c.region->intrinsics;
-        if (!uv || uv->x() < b || uv->y() < b || uv->x() > k.width_px - 1 - b ||
-            uv->y() > k.height_px - 1 - b)
+        const Eigen::Vector2d uv = k.Project(p_C);
+        if (uv.x() < b || uv.y() < b || uv.x() > k.width_px - 1 - b || uv.y() > k.height_px - 1 - b)
           continue;
       }
       candidates.at<uchar>(y, x) = 255;
@@ -330,10 +334,10 @@ SelectionSummary FixationSelector::Choose(const SelectionContext& c, const Patch
   for (int y = 0; y < composite.rows; ++y)
     for (int x = 0; x < composite.cols; ++x) {
       const double v = composite.at<double>(y, x);
-      if (v <= 0) continue;
+      // Only pixels that can win need their distance from the centre.
+      if (v <= 0 || (deterministic ? v < best_value : bin_of(v) != chosen_bin)) continue;
       const double d = centre_dist(x, y);
-      const bool better = deterministic ? (v > best_value || (v == best_value && d < best_dist))
-                                        : (bin_of(v) == chosen_bin && d < best_dist);
+      const bool better = deterministic ? (v > best_value || d < best_dist) : d < best_dist;
       if (better) best_value = v, best_dist = d, bx = x, by = y;
     }
   s.composite_chosen = composite.at<double>(by, bx);
