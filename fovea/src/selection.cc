@@ -103,7 +103,24 @@ cv::Rect PixelsNear(const rig::CameraView& view, const Eigen::Vector3d& p_W, dou
   return cv::Rect(tl, br) & image;
 }
 
+// Calls visit(x, y, r) for each pixel that PixelsNear(p_W, radius) gives,
+// whose map point lies within `radius` of p_W (r its distance): the pixels
+// one point can reach, so that the cost does not grow with the points.
+template <typename Visit>
+void ForPixelsNear(const SelectionContext& c, const Eigen::Vector3d& p_W, double radius,
+                   Visit visit) {
+  const cv::Rect box = PixelsNear(c.view, p_W, radius);
+  for (int y = box.y; y < box.y + box.height; ++y)
+    for (int x = box.x; x < box.x + box.width; ++x) {
+      if (!(c.map_depth_m.at<float>(y, x) > 0)) continue;
+      const double r = (c.MapPoint(x, y) - p_W).norm();
+      if (r < radius) visit(x, y, r);
+    }
+}
+
 }  // namespace
+
+double UniformDraw(std::mt19937_64* rng) { return static_cast<double>((*rng)() >> 11) * 0x1.0p-53; }
 
 cv::Mat LocalSuppression::Evaluate(const SelectionContext& c) const {
   // Every settled point, and each point aimed at where the servo settled
@@ -127,19 +144,14 @@ cv::Mat LocalSuppression::Evaluate(const SelectionContext& c) const {
   // radius of any point, else at most low_ within the radius of any; the
   // order of the points does not matter).
   const double reach = std::max(radius_, revisit_);
-  for (const Eigen::Vector3d& f : points) {
-    const cv::Rect box = PixelsNear(c.view, f, reach);
-    for (int y = box.y; y < box.y + box.height; ++y)
-      for (int x = box.x; x < box.x + box.width; ++x) {
-        if (c.map_depth_m.at<float>(y, x) <= 0) continue;
-        double& wp = w.at<double>(y, x);
-        const double r = (c.MapPoint(x, y) - f).norm();
-        if (r < revisit_)
-          wp = 0;
-        else if (r < radius_)
-          wp = std::min(wp, low_);
-      }
-  }
+  for (const Eigen::Vector3d& f : points)
+    ForPixelsNear(c, f, reach, [&](int x, int y, double r) {
+      double& wp = w.at<double>(y, x);
+      if (r < revisit_)
+        wp = 0;
+      else if (r < radius_)
+        wp = std::min(wp, low_);
+    });
   NormalizeSum(&w);
   return w;
 }
@@ -212,19 +224,17 @@ cv::Mat Candidates(const SelectionContext& c, const std::vector<Eigen::Vector3d>
                    const SelectionOptions& options) {
   cv::Mat candidates(c.map_depth_m.size(), CV_8U, cv::Scalar(0));
   const int b = options.border_px;
-  // ProjectWorldPoint's steps, with the region camera's inverse pose taken
-  // once rather than per pixel.
+  // The region camera's inverse pose once, not per pixel.
   const Eigen::Isometry3d region_T_world =
       c.region ? c.region->world_T_camera.inverse() : Eigen::Isometry3d::Identity();
   for (int y = b; y < candidates.rows - b; ++y)
     for (int x = b; x < candidates.cols - b; ++x) {
       if (!(c.map_depth_m.at<float>(y, x) > 0)) continue;
       if (c.region) {
-        const Eigen::Vector3d p_C = region_T_world * c.MapPoint(x, y);
-        if (!(p_C.z() > 1e-9)) continue;
         const auto& k = c.region->intrinsics;
-        const Eigen::Vector2d uv = k.Project(p_C);
-        if (uv.x() < b || uv.y() < b || uv.x() > k.width_px - 1 - b || uv.y() > k.height_px - 1 - b)
+        const auto uv = ProjectIntoCamera(region_T_world, k, c.MapPoint(x, y));
+        if (!uv || uv->x() < b || uv->y() < b || uv->x() > k.width_px - 1 - b ||
+            uv->y() > k.height_px - 1 - b)
           continue;
       }
       candidates.at<uchar>(y, x) = 255;
@@ -235,30 +245,17 @@ cv::Mat Candidates(const SelectionContext& c, const std::vector<Eigen::Vector3d>
 
 void ClearNear(const SelectionContext& c, const std::vector<Eigen::Vector3d>& points_W,
                double radius_m, cv::Mat* candidates) {
-  // Each point visits only the pixels it can reach (a pixel already out stays
-  // out): the cost does not grow with the points.
-  for (const Eigen::Vector3d& r : points_W) {
-    const cv::Rect box = PixelsNear(c.view, r, radius_m);
-    for (int y = box.y; y < box.y + box.height; ++y)
-      for (int x = box.x; x < box.x + box.width; ++x) {
-        uchar& v = candidates->at<uchar>(y, x);
-        if (v && (c.MapPoint(x, y) - r).norm() < radius_m) v = 0;
-      }
-  }
+  for (const Eigen::Vector3d& p : points_W)
+    ForPixelsNear(c, p, radius_m, [&](int x, int y, double) { candidates->at<uchar>(y, x) = 0; });
 }
 
 void CapNear(const SelectionContext& c, const std::vector<Eigen::Vector3d>& points_W,
              double radius_m, float cap, cv::Mat* weights) {
-  for (const Eigen::Vector3d& r : points_W) {
-    const cv::Rect box = PixelsNear(c.view, r, radius_m);
-    for (int y = box.y; y < box.y + box.height; ++y)
-      for (int x = box.x; x < box.x + box.width; ++x) {
-        float& w = weights->at<float>(y, x);
-        if (w > cap && c.map_depth_m.at<float>(y, x) > 0 &&
-            (c.MapPoint(x, y) - r).norm() < radius_m)
-          w = cap;
-      }
-  }
+  for (const Eigen::Vector3d& p : points_W)
+    ForPixelsNear(c, p, radius_m, [&](int x, int y, double) {
+      float& w = weights->at<float>(y, x);
+      w = std::min(w, cap);
+    });
 }
 
 cv::Mat FixationSelector::Composite(const SelectionContext& c,
@@ -294,7 +291,7 @@ SelectionSummary FixationSelector::Choose(const SelectionContext& c, const Patch
   s.composite_max = c_max;
   s.candidates = cv::countNonZero(composite > 0);
   if (c_max <= 0) {
-    s.why = "no candidate pixel: the map shows nothing in view that may be fixated";
+    s.why = kNoCandidate;
     return s;
   }
   const double cx = c.view.intrinsics.cx_px, cy = c.view.intrinsics.cy_px;
@@ -307,9 +304,7 @@ SelectionSummary FixationSelector::Choose(const SelectionContext& c, const Patch
     chosen_bin = bins - 1;
     s.drawn_value = c_max;
   } else {
-    // 53 random bits -> [0, 1): the same on every platform, unlike the
-    // standard distributions.
-    const double r = static_cast<double>((*rng)() >> 11) * 0x1.0p-53;
+    const double r = UniformDraw(rng);
     s.drawn_value = c_max * (1 - DrawExponential(r, options_.draw_scale));
     std::vector<int> count(bins, 0);
     for (int y = 0; y < composite.rows; ++y)

@@ -8,10 +8,6 @@
 namespace fovea {
 namespace {
 
-// 53 random bits -> [0, 1): the same on every platform, unlike the standard
-// distributions.
-double Uniform01(std::mt19937_64* rng) { return static_cast<double>((*rng)() >> 11) * 0x1.0p-53; }
-
 // The paper's composite rule ("fovea") or its deterministic variant, in the
 // current left view.
 class CompositeStrategy : public FixationStrategy {
@@ -30,8 +26,6 @@ class CompositeStrategy : public FixationStrategy {
   std::string name_;
   FixationSelector selector_;
 };
-
-const char kNoCandidate[] = "no candidate pixel: the map shows nothing in view that may be fixated";
 
 }  // namespace
 
@@ -56,7 +50,7 @@ SelectionSummary RandomStrategy::Choose(const SelectionContext& c, const PatchMa
     return s;
   }
   const size_t i = std::min(candidates.size() - 1,
-                            static_cast<size_t>(Uniform01(rng) * double(candidates.size())));
+                            static_cast<size_t>(UniformDraw(rng) * double(candidates.size())));
   AimAt(c, map, candidates[i].x, candidates[i].y, &s);
   return s;
 }

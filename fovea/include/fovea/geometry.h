@@ -19,6 +19,12 @@ std::optional<Eigen::Vector2d> ProjectWorldPoint(const Eigen::Isometry3d& world_
                                                  const rig::CameraIntrinsics& intrinsics,
                                                  const Eigen::Vector3d& p_W);
 
+/// The same from the inverse pose (camera_T_world = world_T_camera^-1), for
+/// callers that project many points into one camera.
+std::optional<Eigen::Vector2d> ProjectIntoCamera(const Eigen::Isometry3d& camera_T_world,
+                                                 const rig::CameraIntrinsics& intrinsics,
+                                                 const Eigen::Vector3d& p_W);
+
 /// A ray in the world: origin and unit direction.
 struct Ray {
   Eigen::Vector3d origin_W;

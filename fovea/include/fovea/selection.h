@@ -199,6 +199,14 @@ struct SelectionSummary {
   std::vector<std::pair<std::string, double>> criteria;
 };
 
+/// Why a strategy chose nothing when no pixel is a candidate.
+inline constexpr char kNoCandidate[] =
+    "no candidate pixel: the map shows nothing in view that may be fixated";
+
+/// A draw in [0, 1) from 53 random bits: the same on every platform, unlike
+/// the standard distributions.
+double UniformDraw(std::mt19937_64* rng);
+
 /// The pixels a strategy may choose (CV_8U, 255 = candidate): those the map
 /// can raytrace (map_depth_m > 0, filled holes included), at least
 /// `options.border_px` from the edge, inside `context.region` if it is set,
