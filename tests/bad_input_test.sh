@@ -6,7 +6,8 @@
 # folder exactly as it was: no output folder or file left behind, every file
 # that was there untouched. Then the cases that need a process beside them
 # (a sweep holding its folder) and the good inputs that used to fail.
-# Each case is tagged with the item of issue 17 it guards ([1] .. [13]).
+# Each case is tagged with the item of issue 17 it guards ([1] .. [13]), or
+# with the issue (22).
 # Usage: bad_input_test.sh FOVEA SOURCE_DIR WORK_DIR
 set -uo pipefail
 fovea=$(readlink -f "$1")
@@ -27,6 +28,10 @@ long=$(head -c 100000 /dev/zero | tr '\0' 'x')
 boards=${work}_boards  # chessboard pairs (9x6 inner corners), rendered once
 rm -rf "$boards"
 "$fovea" chessboards --out "$boards" --views 3 > /dev/null 2>&1 || fail "fovea chessboards failed"
+heads=${work}_heads  # a head-calibration set: 3 board placements x 4 stage states
+rm -rf "$heads"
+"$fovea" chessboards --head --placements 3 --views 4 --square 0.02 --out "$heads" > /dev/null 2>&1 ||
+  fail "fovea chessboards --head failed"
 cfgs=$src/experiments/configs
 hw="run --config $cfgs/emulated-hardware.yaml --set rig.calibration=$cfgs/emulated-hardware-calibration.yaml"
 scene() {  # scene NAME BODY: a scene file with the rig and BODY in its world
@@ -54,6 +59,15 @@ make_inputs() {
   scene intruder '<geom name="box" type="box" size="0.05 0.05 0.05" pos="0 0.1 0"/>'
   printf '%%YAML:1.0\n---\nleft: {width_px: 320, height_px: 240, fx_px: 600., fy_px: 600., cx_px: 159.5, cy_px: 119.5}\nright: {width_px: 320, height_px: 240, fx_px: 600., fy_px: 600., cx_px: 159.5, cy_px: 119.5}\n' > "$in/small_calibration.yaml"
   cp -r "$boards" "$in/boards"
+  cp -r "$heads" "$in/head"
+  # Head sets the head model cannot use: too few views; every carriage
+  # reading the same; every tilt reading the same (readings as a rig wrote them).
+  head -n 22 "$in/head/views.yaml" > "$in/head/few.yaml"  # 2 header lines, 4 per view
+  sed -E 's/state: \[[^,]*, ([^,]*, [^,]*), [^,]*, /state: [-0.1, \1, 0.1, /' \
+    "$in/head/views.yaml" > "$in/head/fixed_carriage.yaml"
+  sed -E 's/state: \[([^,]*, [^,]*), [^,]*, ([^,]*, [^,]*), [^]]*\]/state: [\1, 0, \2, 0]/' \
+    "$in/head/views.yaml" > "$in/head/fixed_tilt.yaml"
+  printf '%%YAML:1.0\n---\nversion: 3\nleft: {width_px: 640, height_px: 480, fx_px: 1194., fy_px: 1194., cx_px: 319.5, cy_px: 239.5}\nright: {width_px: 640, height_px: 480, fx_px: 1194., fy_px: 1194., cx_px: 319.5, cy_px: 239.5}\n' > "$in/future_calibration.yaml"
 }
 
 snapshot() { (cd "$work" && find t in -printf '%p %y %s\n' | sort && find t -type f -exec md5sum {} + | sort); }
@@ -181,6 +195,15 @@ item=13
 expect 2 "--seconds" indexer-emulator --seconds nan
 expect 2 "--units: address 1 appears twice" indexer-emulator --units 1,1 --seconds 1
 expect 2 "shows a board of 9x6 inner corners, not the 9x4" calibrate --left "$in/boards/left_*.png" --right "$in/boards/right_*.png" --board 9x4 --square 0.025 --out "$t/out.yaml"
+# issue 22: head calibration refuses what cannot determine the head model
+item=22
+expect 2 "shows a board of 9x6 inner corners, not the 8x6" calibrate-head --views "$in/head/views.yaml" --board 8x6 --square 0.02 --out "$t/out.yaml"
+expect 2 "found in only 5 left images (need 8 or more)" calibrate-head --views "$in/head/few.yaml" --board 9x6 --square 0.02 --out "$t/out.yaml"
+expect 2 "cannot determine the left pan zero: its carriage readings span 0 m" calibrate-head --views "$in/head/fixed_carriage.yaml" --board 9x6 --square 0.02 --out "$t/out.yaml"
+expect 2 "cannot determine the left camera's mount" calibrate-head --views "$in/head/fixed_tilt.yaml" --board 9x6 --square 0.02 --out "$t/out.yaml"
+expect 2 "needs a list 'views'" calibrate-head --views "$in/one.yaml" --board 9x6 --square 0.02 --out "$t/out.yaml"
+expect 2 "version 3 is not one this program reads" run --set rig.calibration="$in/future_calibration.yaml" --fixations 1 --out "$t/out"
+expect 2 "--config, --set and --seed go with --head" chessboards --set rig.distortion_k1=-0.2 --out "$t/out"
 # the rest of the class: other user mistakes, and failures at run time (exit 1)
 item=class
 expect 2 "unknown scene 'no_such_scene'" render --scene no_such_scene --out "$t/out"

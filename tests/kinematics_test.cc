@@ -38,3 +38,65 @@ TEST_CASE("positive pan turns the camera to its left, positive tilt looks up", "
   const Eigen::Vector3d tilted = g.WorldFromCamera(rig::Side::kLeft, {0, 0, 0.1}).linear().col(2);
   CHECK(tilted.z() > 0);
 }
+
+TEST_CASE("encoder zeros and the mount turn the camera; the tilt zero folds into the mount",
+          "[rig]") {
+  rig::RigGeometry g = Geometry();
+  rig::HeadGeometry& head = g.left;
+  head.optical_centre_H = {0.02, 0.08, 0.02};
+  head.mount_rpy_rad = {0.026, -0.02, 0.03};
+  head.pan_zero_rad = 0.0017;
+  head.tilt_zero_rad = -0.0017;
+  const rig::CameraStage stage{-0.1, 0.3, -0.2};
+  // A pan zero is a pan: the reading plus the zero.
+  rig::RigGeometry no_zero = g;
+  no_zero.left.pan_zero_rad = 0;
+  const Eigen::Isometry3d a = g.WorldFromCamera(rig::Side::kLeft, stage);
+  const Eigen::Isometry3d b = no_zero.WorldFromCamera(
+      rig::Side::kLeft, {stage.carriage_m, stage.pan_rad + 0.0017, stage.tilt_rad});
+  CHECK((a.matrix() - b.matrix()).norm() < 1e-12);
+  // The mount's roll turns the image about the optical axis.
+  rig::RigGeometry ideal = Geometry();
+  rig::RigGeometry rolled = ideal;
+  rolled.left.mount_rpy_rad = {0.1, 0, 0};
+  const Eigen::Matrix3d r0 = ideal.WorldFromCamera(rig::Side::kLeft, {0, 0, 0}).linear();
+  const Eigen::Matrix3d r1 = rolled.WorldFromCamera(rig::Side::kLeft, {0, 0, 0}).linear();
+  CHECK((r0.col(2) - r1.col(2)).norm() < 1e-12);
+  CHECK(std::acos(r0.col(0).dot(r1.col(0))) == Approx(0.1).margin(1e-12));
+  // Folding the tilt zero into the mount changes no camera pose, anywhere.
+  rig::RigGeometry folded = g;
+  folded.left = head.FoldTiltZero();
+  CHECK(folded.left.tilt_zero_rad == 0);
+  for (const double tilt : {-0.4, 0.0, 0.35}) {
+    const rig::CameraStage s{-0.2, -0.5, tilt};
+    CHECK((g.WorldFromCamera(rig::Side::kLeft, s).matrix() -
+           folded.WorldFromCamera(rig::Side::kLeft, s).matrix())
+              .norm() < 1e-12);
+  }
+  // Mount angles survive the round trip through the rotation.
+  CHECK((rig::MountRpyFromRotation(head.MountRotation()) - head.mount_rpy_rad).norm() < 1e-12);
+}
+
+TEST_CASE("FacingStage allows for the encoders' zeros", "[rig]") {
+  rig::RigGeometry g;
+  g.right.pan_zero_rad = 0.01;
+  g.right.tilt_zero_rad = -0.02;
+  const Eigen::Vector3d p_W(0.3, 1.2, 0.2);
+  const rig::CameraStage s = g.FacingStage(rig::Side::kRight, 0.05, p_W);
+  const Eigen::Isometry3d pose = g.WorldFromCamera(rig::Side::kRight, s);
+  const Eigen::Vector3d to_p = (p_W - pose.translation()).normalized();
+  CHECK((pose.linear().col(2) - to_p).norm() < 1e-12);
+}
+
+TEST_CASE("ParallelStage points any head's camera straight ahead", "[rig]") {
+  rig::RigGeometry g;
+  CHECK(g.ParallelStage(rig::Side::kLeft, -0.1).pan_rad == 0);
+  CHECK(g.ParallelStage(rig::Side::kLeft, -0.1).tilt_rad == 0);
+  g.right.optical_centre_H = {0.02, 0.08, 0.02};
+  g.right.mount_rpy_rad = {0.026, 0.028, -0.026};
+  g.right.pan_zero_rad = -0.0017;
+  g.right.tilt_zero_rad = 0.0017;
+  const rig::CameraStage s = g.ParallelStage(rig::Side::kRight, 0.12);
+  const Eigen::Vector3d axis = g.WorldFromCamera(rig::Side::kRight, s).linear().col(2);
+  CHECK((axis - Eigen::Vector3d::UnitY()).norm() < 1e-12);
+}

@@ -11,8 +11,10 @@
 #include <opencv2/imgproc.hpp>
 
 #include "fovea/geometry.h"
+#include "rig/calibration.h"
 #include "rig/kinematics.h"
 #include "scenes/catalog.h"
+#include "sim/simulation.h"
 #include "temp_scene.h"
 
 namespace {
@@ -70,6 +72,7 @@ const TempScene& PlaneScene() {
 TEST_CASE("camera poses from MuJoCo match the rig's forward kinematics", "[sim]") {
   auto sim = scenes::LoadScene(PlaneScene().path(), sim::SimRigConfig{});
   rig::Rig& rig = sim->rig();
+  // An ideal rig believes itself: the poses it reports are its true ones.
   for (const auto& target :
        {rig.Home(),
         rig::StageState::FromArray({-0.2, 10 * kDeg, -5 * kDeg, 0.15, -20 * kDeg, 8 * kDeg}),
@@ -78,7 +81,8 @@ TEST_CASE("camera poses from MuJoCo match the rig's forward kinematics", "[sim]"
     const rig::StereoFrame frame = rig.Capture();
     for (rig::Side side : {rig::Side::kLeft, rig::Side::kRight}) {
       const Eigen::Isometry3d fk = rig.Geometry().WorldFromCamera(side, frame.state[side]);
-      const Eigen::Isometry3d& mj = frame[side].world_T_camera;
+      CHECK((fk.matrix() - frame[side].world_T_camera.matrix()).norm() < 1e-12);
+      const Eigen::Isometry3d mj = sim->sim_rig().True(side).world_T_camera;
       CHECK((fk.translation() - mj.translation()).norm() < 1e-6);
       const double angle = Eigen::AngleAxisd(fk.linear().transpose() * mj.linear()).angle();
       CHECK(angle < 1e-6);
@@ -205,4 +209,109 @@ TEST_CASE("identical seed and pose give identical images, and noise has its sigm
   cv::meanStdDev(diff, mean, stddev);
   CHECK(std::abs(mean[0]) < 0.1);
   CHECK(stddev[0] == Approx(4.0).epsilon(0.05));  // saturation at 0/255 is rare here
+}
+
+namespace {
+
+// The imperfect rig of issue 22 (lens, mounts, encoder zeros, offsets).
+sim::SimRigConfig ImperfectRig() {
+  sim::SimRigConfig c;
+  c.optical_centre_offset_m = {0.02, 0.08, 0.02};
+  sim::Imperfections& im = c.imperfections;
+  im.k1 = -0.2;
+  im.left.mount_rpy_deg = {1.5, 1.5, 1.5};
+  im.right.mount_rpy_deg = {-1.5, 1.5, -1.5};
+  im.left.pan_zero_deg = im.left.tilt_zero_deg = 0.1;
+  im.right.pan_zero_deg = -0.1;
+  im.right.tilt_zero_deg = 0.1;
+  return c;
+}
+
+// Largest distance between where the rig's belief projects the spheres and
+// where they render, over the points in view (at least one).
+double WorstProjectionPx(sim::Simulation* sim, const std::vector<Eigen::Vector3d>& points) {
+  rig::Rig& rig = sim->rig();
+  double worst = 0;
+  int seen = 0;
+  for (const auto& target :
+       {rig.Home(),
+        rig::StageState::FromArray({-0.08, -3 * kDeg, 2 * kDeg, 0.06, 4 * kDeg, -1.5 * kDeg})}) {
+    rig.MoveTo(target);
+    const rig::StereoFrame frame = rig.Capture();
+    for (rig::Side side : {rig::Side::kLeft, rig::Side::kRight}) {
+      const rig::CameraView& view = frame[side];
+      for (const auto& p : points) {
+        const auto uv = fovea::ProjectWorldPoint(view.world_T_camera, view.intrinsics, p);
+        if (!uv || uv->x() < 40 || uv->y() < 40 || uv->x() > 600 || uv->y() > 440) continue;
+        worst = std::max(worst, (BlobCentroid(view.gray, *uv) - *uv).norm());
+        ++seen;
+      }
+    }
+  }
+  REQUIRE(seen > 0);
+  return worst;
+}
+
+}  // namespace
+
+TEST_CASE("an imperfect rig images its truth and reports its belief; calibrated, they agree",
+          "[sim]") {
+  const std::vector<Eigen::Vector3d> points = {
+      {0.0, 1.0, 0.01}, {0.12, 0.9, 0.05}, {-0.15, 1.1, -0.08}, {0.05, 0.8, -0.06}};
+  const std::string path = WriteSphereScene(points);
+  const sim::SimRigConfig imperfect = ImperfectRig();
+  {
+    // Believing its design, the rig is off by its mounts (1.5 degrees about
+    // each axis, about 50 px) and takes its distorted frames for pinhole ones.
+    auto sim = scenes::LoadScene(path, imperfect);
+    const rig::StereoFrame frame = sim->rig().Capture();
+    CHECK(frame.left.intrinsics.distortion.empty());
+    for (rig::Side side : {rig::Side::kLeft, rig::Side::kRight}) {
+      const Eigen::Matrix3d real = sim->sim_rig().True(side).world_T_camera.linear();
+      const double off_deg =
+          Eigen::AngleAxisd(frame[side].world_T_camera.linear().transpose() * real).angle() / kDeg;
+      CHECK(off_deg > 2.0);
+      CHECK(off_deg < 3.0);
+    }
+  }
+  {
+    // Believing its true calibration, frames come undistorted and the
+    // spheres render where the believed model projects them.
+    rig::RigCalibration truth;
+    truth.left = truth.right = sim::TrueIntrinsics(imperfect);
+    truth.left_head = sim::TrueHead(imperfect, rig::Side::kLeft);
+    truth.right_head = sim::TrueHead(imperfect, rig::Side::kRight);
+    const std::string file = std::filesystem::path(path).parent_path().string() + "/true.yaml";
+    rig::SaveCalibration(file, truth);
+    sim::SimRigConfig calibrated = imperfect;
+    calibrated.calibration = file;
+    auto sim = scenes::LoadScene(path, calibrated);
+    CHECK(sim->rig().Intrinsics(rig::Side::kLeft).distortion.empty());
+    const double worst = WorstProjectionPx(sim.get(), points);
+    INFO("calibrated: worst " << worst << " px");
+    CHECK(worst < 0.3);
+  }
+  std::filesystem::remove_all(std::filesystem::path(path).parent_path());
+}
+
+TEST_CASE("stages with a positioning error stop off their command while the encoders read it",
+          "[sim]") {
+  sim::SimRigConfig c;
+  c.imperfections.position_error_steps = 200;
+  auto sim = scenes::LoadScene(PlaneScene().path(), c);
+  rig::Rig& rig = sim->rig();
+  const rig::StageState target =
+      rig::StageState::FromArray({-0.1, 5 * kDeg, -3 * kDeg, 0.12, -4 * kDeg, 2 * kDeg});
+  rig.MoveTo(target);
+  const rig::StageState command = rig.Limits().Quantize(target);
+  const auto read = rig.State().ToArray(), want = command.ToArray();
+  for (int i = 0; i < rig::kNumAxes; ++i)  // within the settling tolerance of one step
+    CHECK(read[i] == Approx(want[i]).margin(1.0 / rig.Limits().axes[i].steps_per_unit));
+  // The camera really is elsewhere: up to 200 steps of 6400 per degree.
+  const Eigen::Isometry3d believed = rig.Capture().left.world_T_camera;
+  const Eigen::Isometry3d real = sim->sim_rig().True(rig::Side::kLeft).world_T_camera;
+  const double angle_deg =
+      Eigen::AngleAxisd(believed.linear().transpose() * real.linear()).angle() / kDeg;
+  CHECK(angle_deg > 1e-4);
+  CHECK(angle_deg < 0.05);
 }

@@ -8,8 +8,11 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <random>
+#include <sstream>
 
+#include "board.h"
 #include "experiments/config/config.h"
 #include "experiments/output/output.h"
 #include "scenes/catalog.h"
@@ -28,7 +31,7 @@ std::vector<std::string> Glob(const std::string& pattern) {
   return files;
 }
 
-namespace {
+namespace board {
 
 // An image of a calibration set, grey, of the set's size (the first
 // image's); throws UsageError naming the file.
@@ -49,14 +52,53 @@ cv::Mat ReadBoardImage(const std::string& file, cv::Size* size) {
 // The board's inner corners: the sector-based detector first (robust to
 // noise, sub-pixel accurate), the classic one with sub-pixel refinement as a
 // fallback.
+namespace {
+
+// Mean grey level in the 5x5 window around p; nullopt unless the window
+// lies inside the image.
+std::optional<double> MeanAround(const cv::Mat& img, const cv::Point2f& p) {
+  const cv::Rect window(int(std::lround(p.x)) - 2, int(std::lround(p.y)) - 2, 5, 5);
+  if ((window & cv::Rect(0, 0, img.cols, img.rows)) != window) return std::nullopt;
+  return cv::mean(img(window))[0];
+}
+
+// The detectors may return a board's corners from either end (the grid is
+// symmetric under a half turn): when one count is odd and the other even,
+// the squares at the two ends of the diagonal differ in colour, and the
+// corners are put in the order that starts at the dark one, so that every
+// view numbers the same physical corner alike. Judged at whichever end
+// shows both its end square and that square's neighbour; false (board not
+// usable) when neither does.
+bool StartAtDarkCorner(const cv::Mat& img, const cv::Size& pattern,
+                       std::vector<cv::Point2f>* corners) {
+  if ((pattern.width + pattern.height) % 2 == 0) return true;
+  const std::vector<cv::Point2f>& c = *corners;
+  const int n = static_cast<int>(c.size());
+  // At the first corner (end = 0) or the last (end = 1, stepping backwards).
+  for (int end = 0; end < 2; ++end) {
+    const int i = end == 0 ? 0 : n - 1, sign = end == 0 ? 1 : -1;
+    const cv::Point2f along = c[i + sign] - c[i], down = c[i + sign * pattern.width] - c[i];
+    const std::optional<double> outer = MeanAround(img, c[i] - 0.5f * along - 0.5f * down);
+    const std::optional<double> beside = MeanAround(img, c[i] + 0.5f * along - 0.5f * down);
+    if (!outer || !beside) continue;
+    const bool dark_here = *outer < *beside;
+    if (dark_here != (end == 0)) std::reverse(corners->begin(), corners->end());
+    return true;
+  }
+  return false;
+}
+
+}  // namespace
+
 bool FindBoard(const cv::Mat& img, const cv::Size& pattern, std::vector<cv::Point2f>* corners) {
-  if (cv::findChessboardCornersSB(img, pattern, *corners, cv::CALIB_CB_ACCURACY)) return true;
+  if (cv::findChessboardCornersSB(img, pattern, *corners, cv::CALIB_CB_ACCURACY))
+    return StartAtDarkCorner(img, pattern, corners);
   if (!cv::findChessboardCorners(img, pattern, *corners,
                                  cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE))
     return false;
   cv::cornerSubPix(img, *corners, cv::Size(5, 5), cv::Size(-1, -1),
                    cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 1e-4));
-  return true;
+  return StartAtDarkCorner(img, pattern, corners);
 }
 
 // A board with more corners than --board says holds sub-patterns of the
@@ -90,7 +132,49 @@ rig::CameraIntrinsics IntrinsicsOf(const cv::Mat& k, const cv::Mat& dist, const 
   return ki;
 }
 
-}  // namespace
+std::vector<cv::Point3f> Corners(int cols, int rows, double square_m) {
+  std::vector<cv::Point3f> board;
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c)
+      board.emplace_back(float(c * square_m), float(r * square_m), 0.f);
+  return board;
+}
+
+void WriteTexture(const std::string& file) {
+  // The board image: 10 x 7 squares (9 x 6 inner corners: one count even,
+  // one odd, so that its orientation is unambiguous) with a one-square
+  // white margin, 64 px a square; mapped once onto the board's front face.
+  const int px = 64;
+  cv::Mat board((kSquaresY + 2) * px, (kSquaresX + 2) * px, CV_8UC3, cv::Scalar(255, 255, 255));
+  for (int r = 0; r < kSquaresY; ++r)
+    for (int c = 0; c < kSquaresX; ++c)
+      if ((r + c) % 2 == 0)
+        cv::rectangle(board, cv::Rect((c + 1) * px, (r + 1) * px, px, px), cv::Scalar(0, 0, 0),
+                      cv::FILLED);
+  WriteImageAtomic(file, board);
+}
+
+std::string SceneXml(const std::string& body_pose, double square_m) {
+  const double half_w = 0.5 * (kSquaresX + 2) * square_m, half_h = 0.5 * (kSquaresY + 2) * square_m;
+  std::ostringstream x;
+  x << "<mujoco>\n  <include file=\"tavt.xml\"/>\n  <asset>\n"
+    << "    <texture name=\"board\" type=\"2d\" file=\"chessboard.png\"/>\n"
+    << "    <material name=\"board\" texture=\"board\" specular=\"0\" shininess=\"0\"/>\n"
+    << "  </asset>\n  <worldbody>\n"
+    << "    <light directional=\"true\" pos=\"0 0 3\" dir=\"0 1 -0.3\" diffuse=\"0.9 0.9 0.9\" "
+       "specular=\"0 0 0\" castshadow=\"false\"/>\n"
+    << "    <body " << body_pose << ">\n      <geom name=\"board\" type=\"box\" size=\"" << half_w
+    << " " << half_h << " 0.002\" zaxis=\"0 -1 0\" material=\"board\"/>\n    </body>\n"
+    << "  </worldbody>\n</mujoco>\n";
+  return x.str();
+}
+
+}  // namespace board
+
+using board::CheckBoardSize;
+using board::FindBoard;
+using board::IntrinsicsOf;
+using board::ReadBoardImage;
 
 CalibrationResult CalibrateStereo(const std::vector<std::string>& left_files,
                                   const std::vector<std::string>& right_files, int cols, int rows,
@@ -102,10 +186,7 @@ CalibrationResult CalibrateStereo(const std::vector<std::string>& left_files,
     throw UsageError(
         "calibrate: --board needs at least 2x2 inner corners and --square a positive size");
   const cv::Size pattern(cols, rows);
-  std::vector<cv::Point3f> board;
-  for (int r = 0; r < rows; ++r)
-    for (int c = 0; c < cols; ++c)
-      board.emplace_back(float(c * square_m), float(r * square_m), 0.f);
+  const std::vector<cv::Point3f> board = board::Corners(cols, rows, square_m);
   CalibrationResult result;
   std::vector<std::vector<cv::Point3f>> object;
   std::vector<std::vector<cv::Point2f>> points[2];
@@ -149,20 +230,9 @@ CalibrationResult CalibrateStereo(const std::vector<std::string>& left_files,
 SyntheticTruth RenderChessboardViews(const std::string& dir, int views, double square_m,
                                      uint64_t seed) {
   EnsureDirectory(dir);
-  // The board image: 10 x 7 squares (9 x 6 inner corners: one count even,
-  // one odd, so that its orientation is unambiguous) with a one-square
-  // white margin, 64 px a square; mapped once onto the board's front face.
-  const int px = 64, squares_x = 10, squares_y = 7;
-  cv::Mat board((squares_y + 2) * px, (squares_x + 2) * px, CV_8UC3, cv::Scalar(255, 255, 255));
-  for (int r = 0; r < squares_y; ++r)
-    for (int c = 0; c < squares_x; ++c)
-      if ((r + c) % 2 == 0)
-        cv::rectangle(board, cv::Rect((c + 1) * px, (r + 1) * px, px, px), cv::Scalar(0, 0, 0),
-                      cv::FILLED);
   const fs::path scene_dir = fs::path(dir) / ".scenes";
   EnsureDirectory(scene_dir.string());
-  cv::imwrite((scene_dir / "chessboard.png").string(), board);
-  const double half_w = 0.5 * (squares_x + 2) * square_m, half_h = 0.5 * (squares_y + 2) * square_m;
+  board::WriteTexture((scene_dir / "chessboard.png").string());
   std::mt19937_64 rng(seed);
   auto uniform = [&](double a, double b) {
     return std::uniform_real_distribution<double>(a, b)(rng);
@@ -177,16 +247,7 @@ SyntheticTruth RenderChessboardViews(const std::string& dir, int views, double s
                   uniform(-0.03, 0.03), uniform(0.85, 1.0), uniform(-0.02, 0.02), uniform(-25, 25),
                   uniform(-10, 10), uniform(-25, 25));
     const fs::path scene = scene_dir / ("view_" + std::to_string(v) + ".xml");
-    std::ofstream(scene)
-        << "<mujoco>\n  <include file=\"tavt.xml\"/>\n  <asset>\n"
-        << "    <texture name=\"board\" type=\"2d\" file=\"chessboard.png\"/>\n"
-        << "    <material name=\"board\" texture=\"board\" specular=\"0\" shininess=\"0\"/>\n"
-        << "  </asset>\n  <worldbody>\n"
-        << "    <light directional=\"true\" pos=\"0 0 3\" dir=\"0 1 -0.3\" diffuse=\"0.9 0.9 0.9\" "
-           "specular=\"0 0 0\" castshadow=\"false\"/>\n"
-        << "    <body " << pose << ">\n      <geom name=\"board\" type=\"box\" size=\"" << half_w
-        << " " << half_h << " 0.002\" zaxis=\"0 -1 0\" material=\"board\"/>\n    </body>\n"
-        << "  </worldbody>\n</mujoco>\n";
+    std::ofstream(scene) << board::SceneXml(pose, square_m);
     auto sim = scenes::LoadScene(scene.string(), config);
     rig::Rig& rig = sim->rig();
     const rig::StereoFrame frame = rig.Capture();

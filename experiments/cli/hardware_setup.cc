@@ -10,10 +10,10 @@ std::unique_ptr<rig::HardwareRig> MakeHardwareRig(const RunConfig& c,
                                                   std::unique_ptr<rig::IndexerEmulator>* emulator) {
   const RunConfig::Hardware& h = c.hardware;
   rig::HardwareRigConfig hw;
-  hw.calibration = rig::LoadCalibration(h.calibration);
+  hw.calibration = rig::LoadCalibration(c.rig.calibration);
   for (const rig::CameraIntrinsics* k : {&hw.calibration.left, &hw.calibration.right})
     if (k->width_px != c.rig.width_px || k->height_px != c.rig.height_px)
-      throw rig::InputError("calibration " + rig::ClipForMessage(h.calibration) + " is for " +
+      throw rig::InputError("calibration " + rig::ClipForMessage(c.rig.calibration) + " is for " +
                             std::to_string(k->width_px) + "x" + std::to_string(k->height_px) +
                             " images, rig.width_px x rig.height_px is " +
                             std::to_string(c.rig.width_px) + "x" + std::to_string(c.rig.height_px));

@@ -178,13 +178,36 @@ void AddRigParams(RunConfig* c, std::vector<ConfigParam>* params) {
                                     {&ep::kDirections, &h.directions},
                                     {&ep::kLeftCamera, &h.left_camera},
                                     {&ep::kRightCamera, &h.right_camera},
-                                    {&ep::kCalibration, &h.calibration},
+                                    {&ep::kCalibration, &r.calibration},
                                     {&ep::kFrameTimeoutS, &h.frame_timeout_s},
                                     {&ep::kBaselineVelocityMS, &h.baseline_velocity_m_s},
                                     {&ep::kPanTiltVelocityRadS, &h.pan_tilt_velocity_rad_s},
                                     {&sp::kRecordDir, &r.record_dir},
                                     {&sp::kNoiseSigmaDn, &r.noise.read_noise_sigma_dn},
                                     {&sp::kBlurSigmaPx, &r.noise.blur_sigma_px},
+                                });
+  sim::Imperfections& im = r.imperfections;
+  params->insert(params->end(), {
+                                    {&sp::kLeftMountRollDeg, &im.left.mount_rpy_deg.x()},
+                                    {&sp::kLeftMountPitchDeg, &im.left.mount_rpy_deg.y()},
+                                    {&sp::kLeftMountYawDeg, &im.left.mount_rpy_deg.z()},
+                                    {&sp::kRightMountRollDeg, &im.right.mount_rpy_deg.x()},
+                                    {&sp::kRightMountPitchDeg, &im.right.mount_rpy_deg.y()},
+                                    {&sp::kRightMountYawDeg, &im.right.mount_rpy_deg.z()},
+                                    {&sp::kLeftPanZeroDeg, &im.left.pan_zero_deg},
+                                    {&sp::kLeftTiltZeroDeg, &im.left.tilt_zero_deg},
+                                    {&sp::kRightPanZeroDeg, &im.right.pan_zero_deg},
+                                    {&sp::kRightTiltZeroDeg, &im.right.tilt_zero_deg},
+                                    {&sp::kDistortionK1, &im.k1},
+                                    {&sp::kDistortionK2, &im.k2},
+                                    {&sp::kDistortionP1, &im.p1},
+                                    {&sp::kDistortionP2, &im.p2},
+                                    {&sp::kLeftGain, &im.left.gain},
+                                    {&sp::kRightGain, &im.right.gain},
+                                    {&sp::kLeftOffsetDn, &im.left.offset_dn},
+                                    {&sp::kRightOffsetDn, &im.right.offset_dn},
+                                    {&sp::kVignetting, &im.vignetting},
+                                    {&sp::kPositionErrorSteps, &im.position_error_steps},
                                 });
 }
 
@@ -521,7 +544,7 @@ void RunConfig::Check() const {
       throw UsageError("key 'rig.left_camera': a hardware rig needs a left camera");
     if (hardware.right_camera.empty())
       throw UsageError("key 'rig.right_camera': a hardware rig needs a right camera");
-    if (hardware.calibration.empty())
+    if (rig.calibration.empty())
       throw UsageError("key 'rig.calibration': a hardware rig needs a calibration file");
   }
   const double widest = 2 * rig.carriage_max_m;

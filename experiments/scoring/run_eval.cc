@@ -8,6 +8,7 @@
 #include "fovea/geometry.h"
 #include "fovea/integration.h"
 #include "fovea/stats.h"
+#include "sim/sim_rig.h"
 
 namespace experiments {
 using fovea::Quantile;
@@ -91,12 +92,27 @@ cv::Mat NearEdge(const cv::Mat& depth_m) {
 
 }  // namespace
 
-ReferenceView MakeReferenceView(rig::Rig& rig, const sim::GroundTruth& truth) {
+ReferenceView MakeReferenceView(sim::Simulation& sim) {
+  rig::Rig& rig = sim.rig();
+  const sim::GroundTruth& truth = sim.truth();
   ReferenceView ref;
   rig.MoveTo(rig.Home());
   ref.view = rig.Capture().left;
+  // The truth of what the delivered image shows: the true camera (on an
+  // imperfect rig, not where the rig believes it is), its labels carried to
+  // the delivered pixels (nearest: depths and ids are not blended).
+  const sim::SimRig::TrueCamera true_camera = sim.sim_rig().True(rig::Side::kLeft);
   sim::GroundTruth::Labels labels =
-      truth.RenderLabels(ref.view.world_T_camera, ref.view.intrinsics);
+      truth.RenderLabels(true_camera.world_T_camera, true_camera.ideal);
+  if (!true_camera.map_x.empty()) {
+    cv::Mat depth, ids;
+    cv::remap(labels.depth_m, depth, true_camera.map_x, true_camera.map_y, cv::INTER_NEAREST,
+              cv::BORDER_CONSTANT, cv::Scalar(0));
+    cv::remap(labels.geom_ids, ids, true_camera.map_x, true_camera.map_y, cv::INTER_NEAREST,
+              cv::BORDER_CONSTANT, cv::Scalar(-1));
+    labels.depth_m = depth;
+    labels.geom_ids = ids;
+  }
   ref.depth_m = labels.depth_m;
   ref.geom_ids = labels.geom_ids;
   ref.textured = truth.TexturedMask(ref.geom_ids);
@@ -107,7 +123,7 @@ ReferenceView MakeReferenceView(rig::Rig& rig, const sim::GroundTruth& truth) {
   std::vector<double> carriages;
   for (int i = 0; i < kStereoPositions; ++i)
     carriages.push_back(travel.min + (travel.max - travel.min) * i / (kStereoPositions - 1));
-  const Eigen::Vector3d axis = ref.view.world_T_camera.linear().col(2);
+  const Eigen::Vector3d axis = true_camera.world_T_camera.linear().col(2);
   const rig::RigGeometry& geometry = rig.Geometry();
   // Ray casts cost tens of microseconds each against a mesh: first the
   // depth buffer of each carriage position's right camera (60 degrees wide,
@@ -146,7 +162,11 @@ ReferenceView MakeReferenceView(rig::Rig& rig, const sim::GroundTruth& truth) {
     for (int x = 0; x < ref.textured.cols; ++x) {
       const float z = ref.depth_m.at<float>(y, x);
       if (!ref.textured.at<uchar>(y, x) || z <= 0) continue;
-      const fovea::Ray ray = fovea::PixelRay(ref.view.world_T_camera, ref.view.intrinsics, {x, y});
+      const Eigen::Vector2d ideal = true_camera.map_x.empty()
+                                        ? Eigen::Vector2d(x, y)
+                                        : Eigen::Vector2d(true_camera.map_x.at<float>(y, x),
+                                                          true_camera.map_y.at<float>(y, x));
+      const fovea::Ray ray = fovea::PixelRay(true_camera.world_T_camera, true_camera.ideal, ideal);
       const Eigen::Vector3d p = ray.origin_W + ray.direction_W * (z / ray.direction_W.dot(axis));
       if (rendered(p) || RightCameraSees(geometry, carriages, truth, p))
         ref.stereo_visible.at<uchar>(y, x) = 255;

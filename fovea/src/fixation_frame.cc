@@ -39,8 +39,8 @@ double RotationAngle(const Eigen::Matrix3d& R) {
   return std::acos(std::clamp(0.5 * (R.trace() - 1), -1.0, 1.0));
 }
 
-rig::CameraView TurnView(const rig::CameraView& view, const Eigen::Matrix3d& rolled,
-                         cv::Matx33d* H) {
+rig::CameraView TurnView(const rig::CameraView& view, const Eigen::Matrix3d& rolled, cv::Matx33d* H,
+                         int border = cv::BORDER_CONSTANT) {
   const cv::Matx33d K = CameraMatrix(view.intrinsics);
   const Eigen::Matrix3d R = rolled.transpose() * view.world_T_camera.linear();
   cv::Matx33d Rc;
@@ -52,9 +52,8 @@ rig::CameraView TurnView(const rig::CameraView& view, const Eigen::Matrix3d& rol
   out.world_T_camera = view.world_T_camera;
   out.world_T_camera.linear() = rolled;
   const cv::Size size(view.intrinsics.width_px, view.intrinsics.height_px);
-  cv::warpPerspective(view.gray, out.gray, *H, size, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
-  if (!view.bgr.empty())
-    cv::warpPerspective(view.bgr, out.bgr, *H, size, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
+  cv::warpPerspective(view.gray, out.gray, *H, size, cv::INTER_LINEAR, border);
+  if (!view.bgr.empty()) cv::warpPerspective(view.bgr, out.bgr, *H, size, cv::INTER_LINEAR, border);
   return out;
 }
 
@@ -103,6 +102,37 @@ FixationFrame ToFixationFrame(const rig::StereoFrame& frame) {
                       cv::BORDER_CONSTANT);
   f.left_valid = f.left_valid == 255;
   return f;
+}
+
+rig::StereoFrame ToParallelFrame(const rig::StereoFrame& frame) {
+  const Eigen::Matrix3d& left = frame.left.world_T_camera.linear();
+  const Eigen::Matrix3d& right = frame.right.world_T_camera.linear();
+  const Eigen::Vector3d baseline =
+      frame.right.world_T_camera.translation() - frame.left.world_T_camera.translation();
+  if (baseline.norm() < 1e-9) return frame;
+  // x along the rail (world X), not along the centres' offset: cameras
+  // that sit off their axes are turned differently, so their centres also
+  // differ forward and up by millimetres, which at IDR's smallest baselines
+  // would turn the pair by tens of degrees. IDR's baseline is the centres'
+  // offset along x; the rest is a depth-scale error of its order over the
+  // depth, and vertical disparity of f times it over the depth.
+  Eigen::Matrix3d rect;
+  rect.col(0) = Eigen::Vector3d::UnitX();
+  rect.col(2) = (left.col(2) - rect.col(0).dot(left.col(2)) * rect.col(0)).normalized();
+  rect.col(1) = rect.col(2).cross(rect.col(0));
+  const auto& k = frame.left.intrinsics;
+  const double corner =
+      std::hypot(std::max(k.cx_px, k.width_px - k.cx_px), std::max(k.cy_px, k.height_px - k.cy_px));
+  const double angle =
+      std::max(RotationAngle(rect.transpose() * left), RotationAngle(rect.transpose() * right));
+  if (angle * std::max(corner, k.fx_px) < 0.01) return frame;
+  rig::StereoFrame out;
+  out.state = frame.state;
+  out.timestamp_s = frame.timestamp_s;
+  cv::Matx33d H;
+  out.left = TurnView(frame.left, rect, &H, cv::BORDER_REPLICATE);
+  out.right = TurnView(frame.right, rect, &H, cv::BORDER_REPLICATE);
+  return out;
 }
 
 std::vector<cv::Point2d> MapPixels(const cv::Matx33d& H, const std::vector<cv::Point2d>& pixels) {

@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "fovea/fixation_frame.h"
 #include "fovea/params.h"
 #include "fovea/stats.h"
 #include "fovea/timing.h"
@@ -441,14 +442,27 @@ IdrResult RunIdr(rig::Rig& rig, const IdrOptions& options) {
   // the right carriage sets the baseline.
   const double left_x = lb.max;
   const double min_baseline = rb.min - left_x, max_baseline = rb.max - left_x;
+  // Both cameras straight ahead, whatever their mounts and encoder zeros
+  // (pan = tilt = 0 on an ideal rig), and the pair rectified in software
+  // for what the stages cannot set (a no-op on an ideal rig).
+  const rig::RigGeometry& geometry = rig.Geometry();
+  // The baseline is between the optical centres: on a rig whose cameras
+  // sit off their axes, turned differently, the carriages differ by more or
+  // less than it.
+  auto centre_x = [&](rig::Side side, double carriage) {
+    return geometry.WorldFromCamera(side, geometry.ParallelStage(side, carriage)).translation().x();
+  };
+  const double left_centre_x = centre_x(rig::Side::kLeft, left_x);
+  const double right_offset_x = centre_x(rig::Side::kRight, 0);
   auto move_and_capture = [&](double baseline, IdrStage* stage) {
     rig::StageState s;
-    s.left.carriage_m = left_x;
-    s.right.carriage_m = std::clamp(left_x + baseline, rb.min, rb.max);
+    s.left = geometry.ParallelStage(rig::Side::kLeft, left_x);
+    s.right = geometry.ParallelStage(
+        rig::Side::kRight, std::clamp(left_centre_x + baseline - right_offset_x, rb.min, rb.max));
     const rig::MoveResult move = rig.MoveTo(s);
     if (stage) stage->motion_time_s = move.motion_time_s;
     result.motion_time_s += move.motion_time_s;
-    return rig.Capture();
+    return ToParallelFrame(rig.Capture());
   };
 
   // Initial baseline from one image (section II-A).
@@ -472,9 +486,11 @@ IdrResult RunIdr(rig::Rig& rig, const IdrOptions& options) {
     IdrStage stage;
     frame = move_and_capture(baseline, &stage);
     t0 = Clock::now();
-    // The actual baseline, from the camera poses (quantized and settled).
+    // The actual baseline, from the camera poses (quantized and settled):
+    // the optical centres' offset along the rectified rows.
     const double b =
-        (frame.right.world_T_camera.translation() - frame.left.world_T_camera.translation()).norm();
+        (frame.right.world_T_camera.translation() - frame.left.world_T_camera.translation())
+            .dot(frame.left.world_T_camera.linear().col(0));
     stage.baseline_m = b;
     stage.search_limit_px = left_windows.global ? left_windows.global_hi_px : 0;
     const ZeroCrossingImage zc_left = ExtractZeroCrossings(frame.left.gray, options.zero_crossings);

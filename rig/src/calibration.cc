@@ -1,6 +1,7 @@
 #include "rig/calibration.h"
 
 #include <cmath>
+#include <functional>
 #include <opencv2/core.hpp>
 
 #include "rig/input_file.h"
@@ -9,18 +10,49 @@ namespace rig {
 
 namespace {
 
+constexpr double kDeg = M_PI / 180;
+
 void WriteCamera(cv::FileStorage& fs, const char* name, const CameraIntrinsics& k,
-                 const Eigen::Vector3d& offset) {
+                 const HeadGeometry& head) {
+  const Eigen::Vector3d& o = head.optical_centre_H;
+  const Eigen::Vector3d rpy = head.mount_rpy_rad / kDeg;
   fs << name << "{";
   fs << "width_px" << k.width_px << "height_px" << k.height_px;
   fs << "fx_px" << k.fx_px << "fy_px" << k.fy_px << "cx_px" << k.cx_px << "cy_px" << k.cy_px;
   fs << "distortion" << k.distortion;
-  fs << "optical_centre_H_m" << std::vector<double>{offset.x(), offset.y(), offset.z()};
+  fs << "optical_centre_H_m" << std::vector<double>{o.x(), o.y(), o.z()};
+  fs << "mount_rpy_deg" << std::vector<double>{rpy.x(), rpy.y(), rpy.z()};
+  fs << "pan_zero_deg" << head.pan_zero_rad / kDeg;
+  fs << "tilt_zero_deg" << head.tilt_zero_rad / kDeg;
   fs << "}";
 }
 
+// A list of 3 finite numbers under `key`, or zeros if absent.
+Eigen::Vector3d ReadVector3(const cv::FileNode& n, const char* key,
+                            const std::function<void(const std::string&)>& fail) {
+  if (n[key].empty()) return Eigen::Vector3d::Zero();
+  std::vector<double> v;
+  if (!n[key].isSeq()) fail(std::string(key) + " needs 3 numbers");
+  n[key] >> v;
+  if (v.size() != 3) fail(std::string(key) + " needs 3 numbers");
+  const Eigen::Vector3d out(v[0], v[1], v[2]);
+  if (!out.allFinite()) fail(std::string(key) + " holds a non-finite number");
+  return out;
+}
+
+// A finite number under `key` (within +-limit), or 0 if absent.
+double ReadAngle(const cv::FileNode& n, const char* key, double limit,
+                 const std::function<void(const std::string&)>& fail) {
+  if (n[key].empty()) return 0;
+  if (!n[key].isReal() && !n[key].isInt()) fail(std::string("'") + key + "' is not a number");
+  const double v = static_cast<double>(n[key]);
+  if (!std::isfinite(v) || std::abs(v) > limit)
+    fail(std::string("'") + key + "' must be within +-" + std::to_string(int(limit)) + " degrees");
+  return v;
+}
+
 void ReadCamera(const cv::FileStorage& fs, const std::string& path, const char* name,
-                CameraIntrinsics* k, Eigen::Vector3d* offset) {
+                CameraIntrinsics* k, HeadGeometry* head) {
   const cv::FileNode n = fs[name];
   auto fail = [&](const std::string& what) {
     throw InputError("calibration " + ClipForMessage(path) + ": " + name + ": " + what);
@@ -37,11 +69,12 @@ void ReadCamera(const cv::FileStorage& fs, const std::string& path, const char* 
   k->cy_px = static_cast<double>(n["cy_px"]);
   k->distortion.clear();
   if (!n["distortion"].empty()) n["distortion"] >> k->distortion;
-  std::vector<double> o;
-  if (!n["optical_centre_H_m"].empty()) n["optical_centre_H_m"] >> o;
-  if (!o.empty() && o.size() != 3) fail("optical_centre_H_m needs 3 numbers");
-  *offset = o.empty() ? Eigen::Vector3d::Zero() : Eigen::Vector3d(o[0], o[1], o[2]);
-  if (!offset->allFinite()) fail("optical_centre_H_m holds a non-finite number");
+  head->optical_centre_H = ReadVector3(n, "optical_centre_H_m", fail);
+  const Eigen::Vector3d rpy = ReadVector3(n, "mount_rpy_deg", fail);
+  if (rpy.cwiseAbs().maxCoeff() > 45) fail("mount_rpy_deg must be within +-45 degrees");
+  head->mount_rpy_rad = rpy * kDeg;
+  head->pan_zero_rad = ReadAngle(n, "pan_zero_deg", 45, fail) * kDeg;
+  head->tilt_zero_rad = ReadAngle(n, "tilt_zero_deg", 45, fail) * kDeg;
   for (const double d : k->distortion)
     if (!std::isfinite(d)) fail("distortion holds a non-finite number");
   try {
@@ -63,16 +96,27 @@ RigCalibration LoadCalibration(const std::string& path) {
   if (!fs.isOpened())
     throw InputError("calibration '" + ClipForMessage(path) + "' cannot be read (not OpenCV YAML)");
   RigCalibration c;
-  ReadCamera(fs, path, "left", &c.left, &c.left_optical_centre_H);
-  ReadCamera(fs, path, "right", &c.right, &c.right_optical_centre_H);
+  c.version = 1;
+  if (!fs["version"].empty()) {
+    if (!fs["version"].isInt())
+      throw InputError("calibration " + ClipForMessage(path) + ": 'version' is not a whole number");
+    c.version = static_cast<int>(fs["version"]);
+    if (c.version < 1 || c.version > kCalibrationVersion)
+      throw InputError("calibration " + ClipForMessage(path) + ": version " +
+                       std::to_string(c.version) + " is not one this program reads (1 to " +
+                       std::to_string(kCalibrationVersion) + ")");
+  }
+  ReadCamera(fs, path, "left", &c.left, &c.left_head);
+  ReadCamera(fs, path, "right", &c.right, &c.right_head);
   return c;
 }
 
 void SaveCalibration(const std::string& path, const RigCalibration& c) {
   cv::FileStorage fs(path, cv::FileStorage::WRITE | cv::FileStorage::FORMAT_YAML);
   if (!fs.isOpened()) throw RigError("calibration " + path + ": cannot be written");
-  WriteCamera(fs, "left", c.left, c.left_optical_centre_H);
-  WriteCamera(fs, "right", c.right, c.right_optical_centre_H);
+  fs << "version" << kCalibrationVersion;
+  WriteCamera(fs, "left", c.left, c.left_head);
+  WriteCamera(fs, "right", c.right, c.right_head);
 }
 
 }  // namespace rig

@@ -1,5 +1,6 @@
 #include "rig/kinematics.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace rig {
@@ -13,26 +14,77 @@ Eigen::Matrix3d HeadFromCameraRotation() {
   return r;
 }
 
+Eigen::Matrix3d HeadGeometry::MountRotation() const {
+  return (Eigen::AngleAxisd(mount_rpy_rad.z(), Eigen::Vector3d::UnitZ()) *
+          Eigen::AngleAxisd(mount_rpy_rad.y(), Eigen::Vector3d::UnitX()) *
+          Eigen::AngleAxisd(mount_rpy_rad.x(), Eigen::Vector3d::UnitY()))
+      .toRotationMatrix();
+}
+
+Eigen::Isometry3d HeadGeometry::HeadFromCamera() const {
+  Eigen::Isometry3d head_T_camera = Eigen::Isometry3d::Identity();
+  head_T_camera.translation() = optical_centre_H;
+  head_T_camera.linear() = MountRotation() * HeadFromCameraRotation();
+  const Eigen::Isometry3d tilt_zero(Eigen::AngleAxisd(tilt_zero_rad, Eigen::Vector3d::UnitX()));
+  return tilt_zero * head_T_camera;
+}
+
+HeadGeometry HeadGeometry::FoldTiltZero() const {
+  HeadGeometry folded = *this;
+  const Eigen::Isometry3d head_T_camera = HeadFromCamera();
+  folded.tilt_zero_rad = 0;
+  folded.optical_centre_H = head_T_camera.translation();
+  folded.mount_rpy_rad =
+      MountRpyFromRotation(head_T_camera.linear() * HeadFromCameraRotation().transpose());
+  return folded;
+}
+
+Eigen::Vector3d MountRpyFromRotation(const Eigen::Matrix3d& r) {
+  // R = Rz(y) Rx(p) Ry(r): R(2,1) = sin p, R(0,1) = -sin y cos p,
+  // R(1,1) = cos y cos p, R(2,0) = -cos p sin r, R(2,2) = cos p cos r.
+  const double pitch = std::asin(std::clamp(r(2, 1), -1.0, 1.0));
+  const double yaw = std::atan2(-r(0, 1), r(1, 1));
+  const double roll = std::atan2(-r(2, 0), r(2, 2));
+  return {roll, pitch, yaw};
+}
+
 Eigen::Isometry3d RigGeometry::WorldFromHead(Side side, const CameraStage& stage) const {
   const HeadGeometry& head = (*this)[side];
   Eigen::Isometry3d world_T_head = Eigen::Isometry3d::Identity();
   world_T_head.translation() = head.rail_zero_W + stage.carriage_m * Eigen::Vector3d::UnitX();
-  world_T_head.linear() = (Eigen::AngleAxisd(stage.pan_rad, Eigen::Vector3d::UnitZ()) *
-                           Eigen::AngleAxisd(stage.tilt_rad, Eigen::Vector3d::UnitX()))
-                              .toRotationMatrix();
+  world_T_head.linear() =
+      (Eigen::AngleAxisd(stage.pan_rad + head.pan_zero_rad, Eigen::Vector3d::UnitZ()) *
+       Eigen::AngleAxisd(stage.tilt_rad + head.tilt_zero_rad, Eigen::Vector3d::UnitX()))
+          .toRotationMatrix();
   return world_T_head;
 }
 
 CameraStage RigGeometry::FacingStage(Side side, double carriage_m,
                                      const Eigen::Vector3d& p_W) const {
+  const HeadGeometry& head = (*this)[side];
   const Eigen::Vector3d v = p_W - WorldFromHead(side, {carriage_m, 0, 0}).translation();
-  return {carriage_m, std::atan2(-v.x(), v.y()), std::atan2(v.z(), std::hypot(v.x(), v.y()))};
+  return {carriage_m, std::atan2(-v.x(), v.y()) - head.pan_zero_rad,
+          std::atan2(v.z(), std::hypot(v.x(), v.y())) - head.tilt_zero_rad};
+}
+
+CameraStage RigGeometry::ParallelStage(Side side, double carriage_m) const {
+  const HeadGeometry& head = (*this)[side];
+  // The optical axis in the head frame at zero readings, before the zeros:
+  // Rz(p + pan_zero) Rx(t + tilt_zero) d = +y. Tilt first lays d level
+  // (its z to 0), then pan turns it forward.
+  const Eigen::Vector3d d = head.MountRotation() * HeadFromCameraRotation().col(2);
+  const double tilt = std::atan2(-d.z(), d.y());
+  const double level_y = d.y() * std::cos(tilt) - d.z() * std::sin(tilt);
+  const double pan = std::atan2(d.x(), level_y);
+  return {carriage_m, pan - head.pan_zero_rad, tilt - head.tilt_zero_rad};
 }
 
 Eigen::Isometry3d RigGeometry::WorldFromCamera(Side side, const CameraStage& stage) const {
+  // WorldFromHead turns by the tilt zero already: the mount alone here.
+  const HeadGeometry& head = (*this)[side];
   Eigen::Isometry3d head_T_camera = Eigen::Isometry3d::Identity();
-  head_T_camera.translation() = (*this)[side].optical_centre_H;
-  head_T_camera.linear() = HeadFromCameraRotation();
+  head_T_camera.translation() = head.optical_centre_H;
+  head_T_camera.linear() = head.MountRotation() * HeadFromCameraRotation();
   return WorldFromHead(side, stage) * head_T_camera;
 }
 

@@ -1,10 +1,16 @@
 #include "sim/sim_rig.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <utility>
+#include <vector>
 
+#include "rig/calibration.h"
+#include "sim/simulation.h"
 #include "world.h"
 
 namespace sim {
@@ -35,9 +41,62 @@ void ApplySensorModel(const NoiseConfig& noise, uint64_t stream, cv::Mat* image)
   }
 }
 
+// Pixels of camera `from` to the pixels of camera `to` (same pose) that
+// show the same rays, OpenCV's lens models: undistort with from's, project
+// through to's.
+std::vector<cv::Point2f> SameRays(const std::vector<cv::Point2f>& pixels,
+                                  const rig::CameraIntrinsics& from,
+                                  const rig::CameraIntrinsics& to) {
+  std::vector<cv::Point2f> normalized, out;
+  cv::undistortPoints(pixels, normalized, cv::Mat(from.K()), from.distortion);
+  std::vector<cv::Point3f> rays;
+  rays.reserve(normalized.size());
+  for (const cv::Point2f& n : normalized) rays.emplace_back(n.x, n.y, 1.f);
+  cv::projectPoints(rays, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), cv::Mat(to.K()), to.distortion,
+                    out);
+  return out;
+}
+
+bool SameCamera(const rig::CameraIntrinsics& a, const rig::CameraIntrinsics& b) {
+  auto distortion = [](const rig::CameraIntrinsics& k) {
+    std::vector<double> d = k.distortion;
+    while (!d.empty() && d.back() == 0) d.pop_back();
+    return d;
+  };
+  return a.fx_px == b.fx_px && a.fy_px == b.fy_px && a.cx_px == b.cx_px && a.cy_px == b.cy_px &&
+         distortion(a) == distortion(b);
+}
+
+// For every pixel of an image of `chain.front().first`'s size, where it
+// lands after each (from, to) step of `chain` (CV_32FC1 maps for
+// cv::remap); empty maps when every step maps a camera to itself.
+void PixelMaps(const std::vector<std::pair<rig::CameraIntrinsics, rig::CameraIntrinsics>>& chain,
+               cv::Mat* map_x, cv::Mat* map_y) {
+  *map_x = cv::Mat();
+  *map_y = cv::Mat();
+  if (std::all_of(chain.begin(), chain.end(),
+                  [](const auto& step) { return SameCamera(step.first, step.second); }))
+    return;
+  const rig::CameraIntrinsics& first = chain.front().first;
+  std::vector<cv::Point2f> pixels;
+  pixels.reserve(static_cast<size_t>(first.width_px) * first.height_px);
+  for (int v = 0; v < first.height_px; ++v)
+    for (int u = 0; u < first.width_px; ++u) pixels.emplace_back(float(u), float(v));
+  for (const auto& [from, to] : chain)
+    if (!SameCamera(from, to)) pixels = SameRays(pixels, from, to);
+  map_x->create(first.height_px, first.width_px, CV_32FC1);
+  map_y->create(first.height_px, first.width_px, CV_32FC1);
+  for (int v = 0, i = 0; v < first.height_px; ++v)
+    for (int u = 0; u < first.width_px; ++u, ++i) {
+      map_x->at<float>(v, u) = pixels[i].x;
+      map_y->at<float>(v, u) = pixels[i].y;
+    }
+}
+
 }  // namespace
 
-SimRig::SimRig(World* world, const SimRigConfig& config) : world_(world), config_(config) {
+SimRig::SimRig(World* world, const SimRigConfig& config)
+    : world_(world), config_(config), stage_rng_(SplitMix64(config.seed ^ 0x5eedULL)) {
   using rig::Axis;
   const double lin_steps = config.baseline_steps_per_mm * 1000.0;
   const double ang_steps = config.pan_tilt_steps_per_deg / kDegToRad;
@@ -46,10 +105,61 @@ SimRig::SimRig(World* world, const SimRigConfig& config) : world_(world), config
   limits_[Axis::kRightBaseline] = {config.carriage_min_m, config.carriage_max_m, lin_steps};
   limits_[Axis::kLeftPan] = limits_[Axis::kRightPan] = {-pan, pan, ang_steps};
   limits_[Axis::kLeftTilt] = limits_[Axis::kRightTilt] = {-tilt, tilt, ang_steps};
+  // The belief: a calibration file, else the design.
+  const rig::CameraIntrinsics ideal = rig::CameraIntrinsics::FromHorizontalFov(
+      config.width_px, config.height_px, config.horizontal_fov_deg * kDegToRad);
+  rig::RigCalibration belief;
+  if (!config.calibration.empty()) {
+    belief = rig::LoadCalibration(config.calibration);
+    for (rig::Side side : {rig::Side::kLeft, rig::Side::kRight}) {
+      const rig::CameraIntrinsics& k = belief.Intrinsics(side);
+      if (k.width_px != config.width_px || k.height_px != config.height_px)
+        throw rig::InputError(
+            "calibration " + rig::ClipForMessage(config.calibration) + " is for " +
+            std::to_string(k.width_px) + "x" + std::to_string(k.height_px) +
+            " images, rig.width_px x rig.height_px is " + std::to_string(config.width_px) + "x" +
+            std::to_string(config.height_px));
+    }
+  } else {
+    belief.left = belief.right = ideal;
+    belief.left_head.optical_centre_H = belief.right_head.optical_centre_H =
+        config.optical_centre_offset_m;
+  }
+  geometry_.left = belief.left_head;
+  geometry_.right = belief.right_head;
+  geometry_.left.rail_zero_W = geometry_.right.rail_zero_W = Eigen::Vector3d::Zero();
+
+  // The truth's lens and sensor, and how delivered pixels relate to it.
+  const rig::CameraIntrinsics true_k = TrueIntrinsics(config);
+  render_size_ = RenderSize(config);
+  if (!true_k.distortion.empty()) {
+    const cv::Size render = render_size_;
+    rig::CameraIntrinsics wide = ideal;
+    wide.width_px = render.width;
+    wide.height_px = render.height;
+    wide.cx_px = 0.5 * (render.width - 1);
+    wide.cy_px = 0.5 * (render.height - 1);
+    PixelMaps({{true_k, wide}}, &distort_x_, &distort_y_);
+  }
+  const Imperfections& im = config.imperfections;
   for (rig::Side side : {rig::Side::kLeft, rig::Side::kRight}) {
-    rig::HeadGeometry& head = side == rig::Side::kLeft ? geometry_.left : geometry_.right;
-    head.rail_zero_W = Eigen::Vector3d::Zero();
-    head.optical_centre_H = config.optical_centre_offset_m;
+    const int s = static_cast<int>(side);
+    believed_[s] = belief.Intrinsics(side);
+    undistort_[s] = rig::Undistorter(believed_[s]);
+    // Delivered pixel -> raw pixel (through the believed lens) -> ideal
+    // pinhole pixel (the ray the true lens images there).
+    PixelMaps({{rig::Undistorter::Pinhole(believed_[s]), believed_[s]}, {true_k, ideal}},
+              &delivered_x_[s], &delivered_y_[s]);
+    if (im[side].gain != 1 || im.vignetting != 0) {
+      gain_[s].create(config.height_px, config.width_px, CV_32FC1);
+      const double r2_max = ideal.cx_px * ideal.cx_px + ideal.cy_px * ideal.cy_px;
+      for (int v = 0; v < config.height_px; ++v)
+        for (int u = 0; u < config.width_px; ++u) {
+          const double du = u - ideal.cx_px, dv = v - ideal.cy_px;
+          gain_[s].at<float>(v, u) = static_cast<float>(
+              im[side].gain * (1 - im.vignetting * (du * du + dv * dv) / r2_max));
+        }
+    }
   }
 
   // Joint limits and control ranges in SI units on the compiled model.
@@ -79,7 +189,17 @@ rig::MoveResult SimRig::MoveTo(const rig::StageState& target) {
   const std::string violation = limits_.Violation(target);
   if (!violation.empty()) throw rig::RigError("move refused: " + violation);
   const rig::StageState command = limits_.Quantize(target);
-  const auto q_cmd = command.ToArray();
+  // Where the stages really stop: within the positioning error of the
+  // command, while the encoders read the command.
+  auto q_cmd = command.ToArray();
+  const double error_steps = config_.imperfections.position_error_steps;
+  for (int i = 0; i < rig::kNumAxes; ++i) {
+    position_error_[i] = error_steps > 0 ? std::uniform_real_distribution<double>(
+                                               -error_steps, error_steps)(stage_rng_) /
+                                               limits_.axes[i].steps_per_unit
+                                         : 0.0;
+    q_cmd[i] += position_error_[i];
+  }
 
   mjModel* m = world_->m;
   mjData* d = world_->d;
@@ -112,13 +232,43 @@ rig::MoveResult SimRig::MoveTo(const rig::StageState& target) {
 rig::StageState SimRig::State() const {
   std::array<double, rig::kNumAxes> q{};
   for (int i = 0; i < rig::kNumAxes; ++i)
-    q[i] = world_->d->qpos[world_->m->jnt_qposadr[world_->joint_ids[i]]];
+    q[i] = world_->d->qpos[world_->m->jnt_qposadr[world_->joint_ids[i]]] - position_error_[i];
   return rig::StageState::FromArray(q);
 }
 
-rig::CameraIntrinsics SimRig::Intrinsics(rig::Side) const {
-  return rig::CameraIntrinsics::FromHorizontalFov(config_.width_px, config_.height_px,
-                                                  config_.horizontal_fov_deg * kDegToRad);
+rig::CameraIntrinsics SimRig::Intrinsics(rig::Side side) const {
+  return rig::Undistorter::Pinhole(believed_[static_cast<int>(side)]);  // Capture undistorts
+}
+
+SimRig::TrueCamera SimRig::True(rig::Side side) const {
+  const int s = static_cast<int>(side);
+  TrueCamera t;
+  t.world_T_camera = CameraPoseFromMujoco(world_->d, world_->camera_ids[s]);
+  t.ideal = rig::CameraIntrinsics::FromHorizontalFov(config_.width_px, config_.height_px,
+                                                     config_.horizontal_fov_deg * kDegToRad);
+  t.map_x = delivered_x_[s];
+  t.map_y = delivered_y_[s];
+  return t;
+}
+
+void SimRig::ApplyOptics(int side, cv::Mat* image) const {
+  if (!distort_x_.empty()) {
+    cv::Mat distorted;
+    cv::remap(*image, distorted, distort_x_, distort_y_, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+    *image = distorted;
+  }
+  const double offset = config_.imperfections[static_cast<rig::Side>(side)].offset_dn;
+  if (!gain_[side].empty() || offset != 0) {
+    cv::Mat f;
+    image->convertTo(f, CV_32F);
+    if (!gain_[side].empty()) {
+      std::vector<cv::Mat> channels;
+      cv::split(f, channels);
+      for (cv::Mat& c : channels) cv::multiply(c, gain_[side], c);
+      cv::merge(channels, f);
+    }
+    f.convertTo(*image, CV_8U, 1.0, offset);  // rounds and saturates
+  }
 }
 
 double SimRig::TimeS() const { return world_->d->time; }
@@ -132,23 +282,31 @@ rig::StereoFrame SimRig::Capture(const rig::CaptureOptions& options) {
     const int s = static_cast<int>(side);
     rig::CameraView& view = side == rig::Side::kLeft ? frame.left : frame.right;
     cv::Mat rgb;
-    world_->renderer->Render(world_->m, world_->d, world_->camera_ids[s], config_.width_px,
-                             config_.height_px, &rgb, nullptr);
+    world_->renderer->Render(world_->m, world_->d, world_->camera_ids[s], render_size_.width,
+                             render_size_.height, &rgb, nullptr);
     cv::cvtColor(rgb, view.gray, cv::COLOR_RGB2GRAY);
+    ApplyOptics(s, &view.gray);
     ApplySensorModel(config_.noise, base + 2 * s, &view.gray);
     if (options.color) {
       cv::cvtColor(rgb, view.bgr, cv::COLOR_RGB2BGR);
+      ApplyOptics(s, &view.bgr);
       ApplySensorModel(config_.noise, base + 2 * s + 1, &view.bgr);
     }
-    view.intrinsics = Intrinsics(side);
-    view.world_T_camera = CameraPoseFromMujoco(world_->d, world_->camera_ids[s]);
+    const cv::Mat raw = view.gray;  // what a recording keeps: a hardware rig undistorts it
+    if (!options.raw) {
+      view.gray = undistort_[s].Apply(view.gray);
+      if (options.color) view.bgr = undistort_[s].Apply(view.bgr);
+    }
+    view.intrinsics = options.raw ? believed_[s] : Intrinsics(side);
+    // Where the rig believes its camera is: its kinematics at the readings.
+    view.world_T_camera = geometry_.WorldFromCamera(side, frame.state[side]);
     if (!config_.record_dir.empty()) {
       // Numbered from 0 in capture order: OpenCV's image-sequence reader
       // (and a HardwareRig camera) replays them.
       char name[64];
       std::snprintf(name, sizeof name, "/%s_%05llu.png", s == 0 ? "left" : "right",
                     static_cast<unsigned long long>(capture_count_ - 1));
-      if (!cv::imwrite(config_.record_dir + name, view.gray))
+      if (!cv::imwrite(config_.record_dir + name, raw))
         throw rig::RigError("cannot record a capture to '" + config_.record_dir + name + "'");
     }
   }

@@ -226,7 +226,8 @@ std::unique_ptr<Simulation> Simulation::LoadImpl(const std::string& scene_path,
   std::unique_ptr<Simulation> sim(new Simulation());
   sim->world_ = CompileWorld(scene_path, xml, from_memory, config, assets);
   World& w = *sim->world_;
-  w.renderer = new OffscreenRenderer(w.m, config.width_px, config.height_px);
+  const cv::Size render = RenderSize(config);
+  w.renderer = new OffscreenRenderer(w.m, render.width, render.height);
   sim->rig_ = std::make_unique<SimRig>(sim->world_.get(), config);
   sim->truth_ = std::make_unique<GroundTruth>(sim->world_.get());
   sim->config_ = config;
@@ -234,6 +235,7 @@ std::unique_ptr<Simulation> Simulation::LoadImpl(const std::string& scene_path,
 }
 
 rig::Rig& Simulation::rig() { return *rig_; }
+SimRig& Simulation::sim_rig() { return *rig_; }
 const GroundTruth& Simulation::truth() const { return *truth_; }
 const SimRigConfig& Simulation::config() const { return config_; }
 const std::string& Simulation::scene_path() const { return world_->scene_path; }

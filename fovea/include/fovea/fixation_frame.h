@@ -51,6 +51,16 @@ FixationFrame ToFixationFrame(const rig::StereoFrame& frame);
 /// matching).
 FixationFrame OriginalFrame(const rig::StereoFrame& frame);
 
+/// A pair taken with both cameras pointed straight ahead (IDR's), turned in
+/// software into an exactly parallel, rectified one: both views given the
+/// orientation whose x axis runs along the rail (world X) and whose z axis is the
+/// left camera's optical axis made perpendicular to it (y completing it),
+/// each image resampled through K R K^-1 (borders replicated). On an
+/// imperfect rig this removes what the stages cannot: the mounts' roll and
+/// the steps' quantization. Returned as it is when no pixel would move by
+/// a hundredth of a pixel (an ideal rig).
+rig::StereoFrame ToParallelFrame(const rig::StereoFrame& frame);
+
 /// Maps pixels through a 3x3 homography.
 std::vector<cv::Point2d> MapPixels(const cv::Matx33d& H, const std::vector<cv::Point2d>& pixels);
 

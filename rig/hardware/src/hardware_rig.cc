@@ -86,9 +86,12 @@ HardwareRig::HardwareRig(HardwareRigConfig config) : calibration_(config.calibra
     const IndexerAxis& a = config.stages.axes[i];
     limits_.axes[i] = {a.min, a.max, a.steps_per_unit};
   }
-  geometry_.left.optical_centre_H = calibration_.left_optical_centre_H;
-  geometry_.right.optical_centre_H = calibration_.right_optical_centre_H;
+  geometry_.left = calibration_.left_head;
+  geometry_.right = calibration_.right_head;
+  geometry_.left.rail_zero_W = geometry_.right.rail_zero_W = Eigen::Vector3d::Zero();
   home_ = limits_.Quantize(StageState::Parallel(config.home_baseline_m));
+  undistort_[0] = Undistorter(calibration_.left);
+  undistort_[1] = Undistorter(calibration_.right);
   left_ = std::make_unique<CameraSource>(config.left_camera, calibration_.left.width_px,
                                          calibration_.left.height_px, config.frame_timeout);
   right_ = std::make_unique<CameraSource>(config.right_camera, calibration_.right.width_px,
@@ -108,12 +111,10 @@ MoveResult HardwareRig::MoveTo(const StageState& target) {
 StageState HardwareRig::State() const { return state_; }
 
 CameraIntrinsics HardwareRig::Intrinsics(Side side) const {
-  CameraIntrinsics k = side == Side::kLeft ? calibration_.left : calibration_.right;
-  k.distortion.clear();  // Capture undistorts
-  return k;
+  return Undistorter::Pinhole(calibration_.Intrinsics(side));  // Capture undistorts
 }
 
-StereoFrame HardwareRig::Capture(const CaptureOptions&) {
+StereoFrame HardwareRig::Capture(const CaptureOptions& options) {
   StereoFrame frame;
   frame.state = state_;
   frame.timestamp_s =
@@ -121,13 +122,10 @@ StereoFrame HardwareRig::Capture(const CaptureOptions&) {
   for (const Side side : {Side::kLeft, Side::kRight}) {
     CameraView& view = side == Side::kLeft ? frame.left : frame.right;
     const cv::Mat raw = (side == Side::kLeft ? left_ : right_)->Grab();
-    // Frames go out undistorted, with the same pinhole intrinsics.
-    const CameraIntrinsics& k = side == Side::kLeft ? calibration_.left : calibration_.right;
-    if (std::any_of(k.distortion.begin(), k.distortion.end(), [](double d) { return d != 0; }))
-      cv::undistort(raw, view.gray, cv::Mat(k.K()), k.distortion);
-    else
-      view.gray = raw;
-    view.intrinsics = Intrinsics(side);
+    // Frames go out undistorted, with the same pinhole intrinsics, unless
+    // asked for raw.
+    view.gray = options.raw ? raw : undistort_[static_cast<int>(side)].Apply(raw);
+    view.intrinsics = options.raw ? calibration_.Intrinsics(side) : Intrinsics(side);
     view.world_T_camera = geometry_.WorldFromCamera(side, state_[side]);
   }
   return frame;

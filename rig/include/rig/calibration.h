@@ -5,20 +5,33 @@
 #include <Eigen/Core>
 #include <string>
 
+#include "rig/kinematics.h"
 #include "rig/types.h"
 
 namespace rig {
 
+/// The calibration file format this program writes; it reads this one and
+/// the older ones.
+///  1: intrinsics, distortion and optical_centre_H_m per camera (no version key).
+///  2: adds `version`, and per camera mount_rpy_deg, pan_zero_deg, tilt_zero_deg.
+inline constexpr int kCalibrationVersion = 2;
+
 /// What a calibration file holds (OpenCV FileStorage YAML, written by
 /// `fovea calibrate` or by hand): per camera the intrinsics with distortion
-/// and the optical centre's offset from its pan/tilt axes (head frame).
+/// and its head: the optical centre's offset from its pan/tilt axes (head
+/// frame), its mounting rotation and the pan and tilt encoders' zero
+/// offsets (see HeadGeometry; rail_zero_W is not part of a calibration).
 struct RigCalibration {
+  int version = kCalibrationVersion;  ///< of the file it was read from
   CameraIntrinsics left, right;
-  Eigen::Vector3d left_optical_centre_H = Eigen::Vector3d::Zero();
-  Eigen::Vector3d right_optical_centre_H = Eigen::Vector3d::Zero();
+  HeadGeometry left_head, right_head;
+
+  const CameraIntrinsics& Intrinsics(Side side) const { return side == Side::kLeft ? left : right; }
+  const HeadGeometry& Head(Side side) const { return side == Side::kLeft ? left_head : right_head; }
 };
-/// Reads a calibration file (a regular file of at most 64 MiB, OpenCV YAML).
-/// Throws InputError naming the file and the missing or bad entry.
+/// Reads a calibration file (a regular file of at most 64 MiB, OpenCV YAML,
+/// format version 1 or 2). Throws InputError naming the file and the
+/// missing or bad entry, or a version newer than kCalibrationVersion.
 RigCalibration LoadCalibration(const std::string& path);
 void SaveCalibration(const std::string& path, const RigCalibration& calibration);
 

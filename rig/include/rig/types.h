@@ -146,6 +146,11 @@ struct StereoFrame {
 
 struct CaptureOptions {
   bool color = false;  ///< also return BGR images
+  /// The images as the sensors give them, lens distortion kept (for
+  /// calibration); the views' intrinsics then carry the distortion the rig
+  /// believes. By default frames are undistorted to the pinhole camera of
+  /// the same K.
+  bool raw = false;
 };
 
 }  // namespace rig

@@ -7,7 +7,9 @@
 #include <string>
 
 #include "rig/input_file.h"
+#include "rig/kinematics.h"
 #include "rig/param.h"
+#include "rig/types.h"
 
 namespace sim {
 
@@ -66,6 +68,52 @@ inline constexpr ParamSpec kNoiseSigmaDn{"rig.noise_sigma_dn",
                                          "sensor read noise, grey levels (0 = off)", 0, 50};
 inline constexpr ParamSpec kBlurSigmaPx{"rig.blur_sigma_px",
                                         "optical blur before the noise, pixels (0 = off)", 0, 10};
+// The imperfections of a real rig (issue 22); all off by default.
+inline constexpr ParamSpec kLeftMountRollDeg{
+    "rig.left_mount_roll_deg",
+    "left camera's mounting rotation against its head about its optical axis, degrees", -10, 10};
+inline constexpr ParamSpec kLeftMountPitchDeg{"rig.left_mount_pitch_deg",
+                                              "the same about the head's x axis, degrees", -10, 10};
+inline constexpr ParamSpec kLeftMountYawDeg{"rig.left_mount_yaw_deg",
+                                            "the same about the head's z axis, degrees", -10, 10};
+inline constexpr ParamSpec kRightMountRollDeg{
+    "rig.right_mount_roll_deg", "right camera's mounting rotation, roll, degrees", -10, 10};
+inline constexpr ParamSpec kRightMountPitchDeg{
+    "rig.right_mount_pitch_deg", "right camera's mounting rotation, pitch, degrees", -10, 10};
+inline constexpr ParamSpec kRightMountYawDeg{
+    "rig.right_mount_yaw_deg", "right camera's mounting rotation, yaw, degrees", -10, 10};
+inline constexpr ParamSpec kLeftPanZeroDeg{
+    "rig.left_pan_zero_deg",
+    "left pan encoder's home error: the true angle is the reading plus this, degrees", -5, 5};
+inline constexpr ParamSpec kLeftTiltZeroDeg{"rig.left_tilt_zero_deg",
+                                            "left tilt encoder's home error, degrees", -5, 5};
+inline constexpr ParamSpec kRightPanZeroDeg{"rig.right_pan_zero_deg",
+                                            "right pan encoder's home error, degrees", -5, 5};
+inline constexpr ParamSpec kRightTiltZeroDeg{"rig.right_tilt_zero_deg",
+                                             "right tilt encoder's home error, degrees", -5, 5};
+inline constexpr ParamSpec kDistortionK1{
+    "rig.distortion_k1", "both lenses: radial distortion k1 (OpenCV's model; barrel < 0)", -0.5,
+    0.5};
+inline constexpr ParamSpec kDistortionK2{"rig.distortion_k2", "both lenses: radial k2", -0.5, 0.5};
+inline constexpr ParamSpec kDistortionP1{"rig.distortion_p1", "both lenses: tangential p1", -0.01,
+                                         0.01};
+inline constexpr ParamSpec kDistortionP2{"rig.distortion_p2", "both lenses: tangential p2", -0.01,
+                                         0.01};
+inline constexpr ParamSpec kLeftGain{"rig.left_gain", "left sensor's gain (1 = ideal)", 0.5, 2};
+inline constexpr ParamSpec kRightGain{"rig.right_gain", "right sensor's gain", 0.5, 2};
+inline constexpr ParamSpec kLeftOffsetDn{"rig.left_offset_dn",
+                                         "left sensor's black-level offset, grey levels", -50, 50};
+inline constexpr ParamSpec kRightOffsetDn{
+    "rig.right_offset_dn", "right sensor's black-level offset, grey levels", -50, 50};
+inline constexpr ParamSpec kVignetting{
+    "rig.vignetting",
+    "both lenses: share of brightness lost at the image corners, falling off as radius squared", 0,
+    0.8};
+inline constexpr ParamSpec kPositionErrorSteps{
+    "rig.position_error_steps",
+    "each axis stops uniformly within +- this many motor steps of its command while its encoder "
+    "reads the command (backlash, missed steps; 0 = exact)",
+    0, 10000};
 inline constexpr ParamSpec kRecordDir{
     "rig.record_dir",
     "sim: also write every capture to this folder (left_NNNNN.png, right_NNNNN.png) for replay"};
@@ -78,6 +126,27 @@ struct NoiseConfig {
   double read_noise_sigma_dn = 0;  ///< standard deviation in 8-bit grey levels
   double blur_sigma_px = 0;        ///< 0 disables the blur
   void Check() const;              ///< throws rig::InputError naming the key (params)
+};
+
+/// One camera's departures from the ideal head (see rig::HeadGeometry).
+struct CameraImperfections {
+  Eigen::Vector3d mount_rpy_deg = Eigen::Vector3d::Zero();  ///< roll, pitch, yaw
+  double pan_zero_deg = 0, tilt_zero_deg = 0;
+  double gain = 1, offset_dn = 0;
+};
+
+/// What makes the simulated rig a real one. Off by default: the rig is then
+/// ideal and believes itself exactly.
+struct Imperfections {
+  CameraImperfections left, right;
+  double k1 = 0, k2 = 0, p1 = 0, p2 = 0;  ///< both lenses, OpenCV's model
+  double vignetting = 0;
+  double position_error_steps = 0;
+
+  const CameraImperfections& operator[](rig::Side side) const {
+    return side == rig::Side::kLeft ? left : right;
+  }
+  bool Distorted() const { return k1 != 0 || k2 != 0 || p1 != 0 || p2 != 0; }
 };
 
 /// Everything that defines the simulated rig. Defaults follow the paper's
@@ -108,7 +177,14 @@ struct SimRigConfig {
   double move_timeout_s = 30;  ///< simulated seconds
 
   NoiseConfig noise;
-  uint64_t seed = 0;  ///< seeds the sensor noise
+  uint64_t seed = 0;  ///< seeds the sensor noise and the stages' positioning error
+
+  /// What the rig is, beyond its design (the rig renders this).
+  Imperfections imperfections;
+  /// What the rig believes it is: a calibration file (rig.calibration). Empty:
+  /// its design (the intrinsics of horizontal_fov_deg, the optical-centre
+  /// offset above, no distortion, no mount rotation, zero encoder errors).
+  std::string calibration;
 
   /// When set, every capture's grey images are also written to this folder
   /// as left_NNNNN.png / right_NNNNN.png in capture order (for replaying a

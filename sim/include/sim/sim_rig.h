@@ -1,9 +1,12 @@
 // The simulated TAVT behind the rig interface.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <random>
 
 #include "rig/rig.h"
+#include "rig/undistort.h"
 #include "sim/config.h"
 
 namespace sim {
@@ -14,7 +17,13 @@ struct World;
 /// rotor inertia, damping and force limits, so a move takes physical time.
 /// Commands are quantized to motor steps; MoveTo steps the physics until the
 /// stages settle. Capture renders both cameras offscreen (OSMesa) and applies
-/// the seeded sensor-noise model.
+/// the lens and sensor models: distortion, vignetting, gain and offset, blur,
+/// seeded read noise.
+///
+/// What the rig is (SimRigConfig::imperfections) and what it believes it is
+/// (SimRigConfig::calibration, else its design) are kept apart, as on a real
+/// rig: State, Geometry, Intrinsics and the poses Capture reports are its
+/// belief; the renderer images the truth (TrueCamera).
 class SimRig : public rig::Rig {
  public:
   SimRig(World* world, const SimRigConfig& config);
@@ -30,13 +39,36 @@ class SimRig : public rig::Rig {
   /// Simulated time since load, seconds.
   double TimeS() const;
 
+  /// What a delivered (undistorted) image of one camera really shows: the
+  /// camera's true pose now, its ideal pinhole intrinsics (the
+  /// configuration's), and for every delivered pixel the pixel of that ideal
+  /// camera that shows the same ray (CV_32FC1 maps; empty when the two are
+  /// the same pixel, as on a rig without distortion that believes its true K).
+  struct TrueCamera {
+    Eigen::Isometry3d world_T_camera = Eigen::Isometry3d::Identity();
+    rig::CameraIntrinsics ideal;
+    cv::Mat map_x, map_y;
+  };
+  TrueCamera True(rig::Side side) const;
+
  private:
   World* world_;
   SimRigConfig config_;
   rig::RigLimits limits_;
-  rig::RigGeometry geometry_;
+  rig::RigGeometry geometry_;                      ///< believed
+  std::array<rig::CameraIntrinsics, 2> believed_;  ///< with the believed distortion
+  std::array<rig::Undistorter, 2> undistort_;      ///< the believed distortion removed
+  cv::Size render_size_;                           ///< RenderSize(config)
+  cv::Mat distort_x_, distort_y_;  ///< render -> distorted image; empty for ideal lenses
+  std::array<cv::Mat, 2> gain_;    ///< per pixel: gain x vignetting; empty when ideal
+  std::array<cv::Mat, 2> delivered_x_, delivered_y_;  ///< see TrueCamera
   rig::StageState home_;
+  std::array<double, rig::kNumAxes> position_error_{};  ///< true - encoder reading, per axis
+  std::mt19937_64 stage_rng_;
   uint64_t capture_count_ = 0;
+
+  /// The rendered image of one camera through the lens and sensor models.
+  void ApplyOptics(int side, cv::Mat* image) const;
 };
 
 }  // namespace sim

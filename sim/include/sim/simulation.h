@@ -26,6 +26,18 @@ inline constexpr const char* kRigIncludeName = "tavt.xml";
 /// MJCF text of the TAVT for a configuration (what a scene's include reads).
 std::string RigMjcf(const SimRigConfig& config);
 
+/// The head the simulated rig really has (its imperfections included), as
+/// rig::HeadGeometry (rail zero at the world origin).
+rig::HeadGeometry TrueHead(const SimRigConfig& config, rig::Side side);
+/// The camera the simulated rig really has: the ideal intrinsics of the
+/// configuration's size and field, with the lenses' true distortion.
+rig::CameraIntrinsics TrueIntrinsics(const SimRigConfig& config);
+/// The size the rig's cameras render at: the images' size for an
+/// undistorted lens; for a distorted one, an undistorted image of the same
+/// focal length and centred principal point wide and high enough that every
+/// pixel of the distorted image lies inside it.
+cv::Size RenderSize(const SimRigConfig& config);
+
 /// The box, in the world, that scene geometry must keep out of: the rig's
 /// rail, carriages and heads over their whole travel (scene rule 3, see
 /// scenes/README.md).
@@ -61,6 +73,8 @@ class Simulation {
   Simulation& operator=(const Simulation&) = delete;
 
   rig::Rig& rig();
+  /// The same rig, with what only a simulated rig can say (SimRig::True).
+  SimRig& sim_rig();
   const GroundTruth& truth() const;
   const SimRigConfig& config() const;
   const std::string& scene_path() const;

@@ -62,7 +62,9 @@ inline constexpr ParamSpec kLeftCamera{
 inline constexpr ParamSpec kRightCamera{"rig.right_camera",
                                         "hardware: right camera, as rig.left_camera"};
 inline constexpr ParamSpec kCalibration{
-    "rig.calibration", "hardware: calibration file (fovea calibrate, or OpenCV YAML by hand)"};
+    "rig.calibration",
+    "calibration file (fovea calibrate, or OpenCV YAML by hand): what the rig believes it is; a "
+    "hardware rig needs one, a simulated one without it believes its design"};
 inline constexpr ParamSpec kFrameTimeoutS{
     "rig.frame_timeout_s", "hardware: longest wait for a camera frame, seconds", 0.01, 60};
 inline constexpr ParamSpec kBaselineVelocityMS{
@@ -105,7 +107,7 @@ struct RunConfig {
     bool emulate_stages = false;
     std::string units = "1,2,3,4,5,6";       ///< indexer addresses in rig::Axis order
     std::string directions = "1,1,1,1,1,1";  ///< motor direction signs in rig::Axis order
-    std::string left_camera, right_camera, calibration;
+    std::string left_camera, right_camera;   // the calibration is rig.calibration (SimRigConfig)
     double frame_timeout_s = 2;
     double baseline_velocity_m_s = 0.05;
     double pan_tilt_velocity_rad_s = 1.0;

@@ -10,6 +10,7 @@
 #include "fovea/patch.h"
 #include "rig/rig.h"
 #include "sim/ground_truth.h"
+#include "sim/simulation.h"
 
 namespace experiments {
 
@@ -48,8 +49,11 @@ constexpr double kBadShare = 0.01;
 /// ReferenceView::stereo_visible.
 constexpr int kStereoPositions = 8;
 
-/// Moves the rig home and captures the left camera there.
-ReferenceView MakeReferenceView(rig::Rig& rig, const sim::GroundTruth& truth);
+/// Moves the rig home and captures the left camera there. The truth is what
+/// the delivered image really shows: on an imperfect rig, the true camera's
+/// view carried to the delivered pixels (sim::SimRig::True), whatever the
+/// rig believes.
+ReferenceView MakeReferenceView(sim::Simulation& sim);
 
 struct ErrorFigures {
   long pixels = 0;   ///< mapped textured pixels scored

@@ -11,6 +11,7 @@
 #include "rig/calibration.h"
 #include "rig/hardware/indexer.h"
 #include "rig/rig.h"
+#include "rig/undistort.h"
 
 namespace rig {
 
@@ -61,6 +62,7 @@ class HardwareRig : public Rig {
   RigCalibration calibration_;
   std::unique_ptr<IndexerDriver> driver_;
   std::unique_ptr<CameraSource> left_, right_;
+  Undistorter undistort_[2];  // per side, from the calibration
   RigLimits limits_;
   RigGeometry geometry_;
   StageState home_;
