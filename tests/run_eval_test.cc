@@ -8,7 +8,7 @@
 TEST_CASE("reference view: the strip past a near left edge is out of every right camera's sight",
           "[experiments][scoring][slow]") {
   auto sim = scenes::LoadScene("three_surfaces", {});
-  const experiments::ReferenceView ref = experiments::MakeReferenceView(*sim);
+  const experiments::ReferenceView ref = experiments::MakeReferenceView(sim->rig(), *sim);
   REQUIRE(ref.textured_pixels > 0);
   CHECK(cv::countNonZero(ref.stereo_visible & ~ref.textured) == 0);
   const double share = double(ref.stereo_visible_pixels) / ref.textured_pixels;
@@ -38,7 +38,7 @@ TEST_CASE("reference view: the strip past a near left edge is out of every right
 TEST_CASE("reference view: with no near edge to hide behind, every textured pixel is in sight",
           "[experiments][scoring][slow]") {
   auto sim = scenes::LoadScene("fronto_planes", {});
-  const experiments::ReferenceView ref = experiments::MakeReferenceView(*sim);
+  const experiments::ReferenceView ref = experiments::MakeReferenceView(sim->rig(), *sim);
   REQUIRE(ref.textured_pixels > 0);
   CHECK(ref.stereo_visible_pixels >= 0.99 * ref.textured_pixels);
 }

@@ -70,7 +70,7 @@ int RunStatic(const RunConfig& config, OutputFolder& folder, Clock::time_point t
   rig::Rig& rig = sim->rig();
   const std::string dir = folder.path();
   WriteTextAtomic(dir + "/" + rf::kConfig, DumpConfig(config));
-  const ReferenceView ref = MakeReferenceView(*sim);
+  const ReferenceView ref = MakeReferenceView(rig, *sim);
   const StaticSgbmResult r = RunStaticSgbm(rig, StaticOptionsOf(config));
   const MapScore score = ScoreMap(r.map, ref, sim->truth(), r.baseline_m, /*per_patch=*/true);
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
@@ -213,7 +213,7 @@ int Run(const RunArgs& args) {
   const std::string dir = folder.path();
   WriteTextAtomic(dir + "/" + rf::kConfig, DumpConfig(config));
   auto t = Clock::now();
-  const ReferenceView ref = MakeReferenceView(*sim);
+  const ReferenceView ref = MakeReferenceView(rig, *sim);
   const double reference_s = Since(t);
   rf::Recorder recorder(dir, sim->scene_path(), ref, sim->truth(), config);
   fovea::FoveaOptions options = config.fovea;

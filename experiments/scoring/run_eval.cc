@@ -92,12 +92,13 @@ cv::Mat NearEdge(const cv::Mat& depth_m) {
 
 }  // namespace
 
-ReferenceView MakeReferenceView(sim::Simulation& sim) {
-  rig::Rig& rig = sim.rig();
+ReferenceView MakeReferenceView(rig::Rig& rig, sim::Simulation& sim) {
   const sim::GroundTruth& truth = sim.truth();
   ReferenceView ref;
   rig.MoveTo(rig.Home());
   ref.view = rig.Capture().left;
+  // The scene's model at the same pose (a hardware run's rig is another).
+  if (&rig != &sim.rig()) sim.rig().MoveTo(sim.rig().Home());
   // The truth of what the delivered image shows: the true camera (on an
   // imperfect rig, not where the rig believes it is), its labels carried to
   // the delivered pixels (nearest: depths and ids are not blended).

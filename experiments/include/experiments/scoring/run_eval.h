@@ -49,11 +49,12 @@ constexpr double kBadShare = 0.01;
 /// ReferenceView::stereo_visible.
 constexpr int kStereoPositions = 8;
 
-/// Moves the rig home and captures the left camera there. The truth is what
-/// the delivered image really shows: on an imperfect rig, the true camera's
-/// view carried to the delivered pixels (sim::SimRig::True), whatever the
-/// rig believes.
-ReferenceView MakeReferenceView(sim::Simulation& sim);
+/// Moves `rig` (the scene's simulated rig, or a hardware rig in front of
+/// the scene `sim` models) home and captures the left camera there. The
+/// truth is what the delivered image really shows: the true camera of the
+/// scene's model at home, its view carried to the delivered pixels
+/// (sim::SimRig::True), whatever the rig believes.
+ReferenceView MakeReferenceView(rig::Rig& rig, sim::Simulation& sim);
 
 struct ErrorFigures {
   long pixels = 0;   ///< mapped textured pixels scored
