@@ -23,8 +23,10 @@ void CheckBoardSize(const cv::Mat& img, const cv::Size& pattern, const std::stri
 rig::CameraIntrinsics IntrinsicsOf(const cv::Mat& k, const cv::Mat& dist, const cv::Size& size);
 /// Board coordinates of the inner corners, row by row, metres (z = 0).
 std::vector<cv::Point3f> Corners(int cols, int rows, double square_m);
-/// Writes the board's texture image.
-void WriteTexture(const std::string& file);
+/// Creates `dir` and a scene folder inside it holding the board's texture
+/// (chessboard.png, for SceneXml); returns the scene folder's path, which
+/// the caller removes when done.
+std::string PrepareSceneFolder(const std::string& dir);
 /// MJCF of a scene with the rig and the board (texture "chessboard.png"
 /// beside it) on a body with `body_pose` (MJCF attributes); the board faces
 /// -y of that body's frame... its front face looks along the body's -y.

@@ -140,7 +140,10 @@ std::vector<cv::Point3f> Corners(int cols, int rows, double square_m) {
   return board;
 }
 
-void WriteTexture(const std::string& file) {
+std::string PrepareSceneFolder(const std::string& dir) {
+  EnsureDirectory(dir);
+  const std::string scene_dir = (fs::path(dir) / ".scenes").string();
+  EnsureDirectory(scene_dir);
   // The board image: 10 x 7 squares (9 x 6 inner corners: one count even,
   // one odd, so that its orientation is unambiguous) with a one-square
   // white margin, 64 px a square; mapped once onto the board's front face.
@@ -151,7 +154,8 @@ void WriteTexture(const std::string& file) {
       if ((r + c) % 2 == 0)
         cv::rectangle(board, cv::Rect((c + 1) * px, (r + 1) * px, px, px), cv::Scalar(0, 0, 0),
                       cv::FILLED);
-  WriteImageAtomic(file, board);
+  WriteImageAtomic((fs::path(scene_dir) / "chessboard.png").string(), board);
+  return scene_dir;
 }
 
 std::string SceneXml(const std::string& body_pose, double square_m) {
@@ -229,10 +233,7 @@ CalibrationResult CalibrateStereo(const std::vector<std::string>& left_files,
 
 SyntheticTruth RenderChessboardViews(const std::string& dir, int views, double square_m,
                                      uint64_t seed) {
-  EnsureDirectory(dir);
-  const fs::path scene_dir = fs::path(dir) / ".scenes";
-  EnsureDirectory(scene_dir.string());
-  board::WriteTexture((scene_dir / "chessboard.png").string());
+  const fs::path scene_dir = board::PrepareSceneFolder(dir);
   std::mt19937_64 rng(seed);
   auto uniform = [&](double a, double b) {
     return std::uniform_real_distribution<double>(a, b)(rng);

@@ -527,10 +527,7 @@ HeadCalibrationResult CalibrateHead(const std::vector<HeadView>& views, int cols
 rig::RigCalibration RenderHeadChessboards(const std::string& dir, const sim::SimRigConfig& config,
                                           int placements, int views_per_placement, double square_m,
                                           uint64_t seed) {
-  EnsureDirectory(dir);
-  const fs::path scene_dir = fs::path(dir) / ".scenes";
-  EnsureDirectory(scene_dir.string());
-  board::WriteTexture((scene_dir / "chessboard.png").string());
+  const fs::path scene_dir = board::PrepareSceneFolder(dir);
   std::mt19937_64 rng(seed);
   auto uniform = [&](double a, double b) {
     return std::uniform_real_distribution<double>(a, b)(rng);
