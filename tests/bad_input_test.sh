@@ -203,7 +203,8 @@ expect 2 "cannot determine the left pan zero: its carriage readings span 0 m" ca
 expect 2 "cannot determine the left camera's mount" calibrate-head --views "$in/head/fixed_tilt.yaml" --board 9x6 --square 0.02 --out "$t/out.yaml"
 expect 2 "needs a list 'views'" calibrate-head --views "$in/one.yaml" --board 9x6 --square 0.02 --out "$t/out.yaml"
 expect 2 "version 3 is not one this program reads" run --set rig.calibration="$in/future_calibration.yaml" --fixations 1 --out "$t/out"
-expect 2 "--config, --set and --seed go with --head" chessboards --set rig.distortion_k1=-0.2 --out "$t/out"
+expect 2 "--config, --set, --seed and --states go with --head" chessboards --set rig.distortion_k1=-0.2 --out "$t/out"
+expect 2 "views file '/nonexistent/views.yaml'" chessboards --head --states /nonexistent/views.yaml --out "$t/out"
 # the rest of the class: other user mistakes, and failures at run time (exit 1)
 item=class
 expect 2 "unknown scene 'no_such_scene'" render --scene no_such_scene --out "$t/out"

@@ -39,3 +39,13 @@ hw_cov=$(coverage "$work/hw_imperfect")
 awk -v a="$sim_cov" -v b="$hw_cov" 'BEGIN { exit !(a > 0.3 && (a - b < 0.02 && b - a < 0.02)) }' ||
   fail "imperfect rig: the hardware replay's coverage $hw_cov is not the simulated run's $sim_cov"
 echo "PASS: imperfect rig, calibrated: simulated coverage $sim_cov, replayed through the hardware rig $hw_cov"
+
+# Head-calibration views captured on the hardware rig (fovea chessboards
+# --head --states): it moves through the planned stage states, grabs raw
+# pairs and writes the readings it reached.
+"$fovea" chessboards --head --states "$work/boards/views.yaml" --config experiments/configs/emulated-hardware.yaml \
+  --set rig.calibration="$cal" --set rig.left_camera="$work/rec_imperfect/left_%05d.png" \
+  --set rig.right_camera="$work/rec_imperfect/right_%05d.png" --out "$work/captured" > /dev/null
+[ "$(ls "$work/captured" | grep -c '^left_')" -eq 3 ] || fail "the hardware capture did not write 3 pairs"
+[ "$(grep -c 'state:' "$work/captured/views.yaml")" -eq 3 ] || fail "the captured views.yaml lists no 3 states"
+echo "PASS: 3 head-calibration pairs captured on the hardware rig at the planned stage states"

@@ -234,7 +234,7 @@ std::string Degrees(double rad) {
 
 }  // namespace
 
-std::vector<HeadView> LoadHeadViews(const std::string& path) {
+std::vector<HeadView> LoadHeadViews(const std::string& path, bool images) {
   const std::string text = rig::ReadInputFile(path, "views file");
   const fs::path folder = fs::path(path).parent_path();
   auto fail = [&](const std::string& what) {
@@ -255,9 +255,9 @@ std::vector<HeadView> LoadHeadViews(const std::string& path) {
     HeadView v;
     try {
       for (const char* key : {"left", "right", "state"})
-        if (!n[key]) fail(where + "lacks '" + key + "'");
-      v.left = (folder / n["left"].as<std::string>()).string();
-      v.right = (folder / n["right"].as<std::string>()).string();
+        if (!n[key] && (images || std::string(key) == "state")) fail(where + "lacks '" + key + "'");
+      if (n["left"]) v.left = (folder / n["left"].as<std::string>()).string();
+      if (n["right"]) v.right = (folder / n["right"].as<std::string>()).string();
       v.placement = n["placement"] ? n["placement"].as<int>() : 0;
       const std::vector<double> s = n["state"].as<std::vector<double>>();
       if (s.size() != rig::kNumAxes) fail(where + "'state' needs 6 numbers");
@@ -522,6 +522,25 @@ HeadCalibrationResult CalibrateHead(const std::vector<HeadView>& views, int cols
     (s == 0 ? result.calibration.left_head : result.calibration.right_head) = head;
   }
   return result;
+}
+
+void CaptureHeadViews(rig::Rig& rig, const std::vector<HeadView>& plan, const std::string& dir,
+                      const std::function<void(int placement)>& before_placement) {
+  std::vector<HeadView> views;
+  for (size_t i = 0; i < plan.size(); ++i) {
+    if (i == 0 || plan[i].placement != plan[i - 1].placement) before_placement(plan[i].placement);
+    rig.MoveTo(plan[i].state);
+    rig::CaptureOptions raw;
+    raw.raw = true;
+    const rig::StereoFrame frame = rig.Capture(raw);
+    char name[2][64];
+    std::snprintf(name[0], sizeof name[0], "left_%02zu.png", i);
+    std::snprintf(name[1], sizeof name[1], "right_%02zu.png", i);
+    WriteImageAtomic((fs::path(dir) / name[0]).string(), frame.left.gray);
+    WriteImageAtomic((fs::path(dir) / name[1]).string(), frame.right.gray);
+    views.push_back({rig.State(), name[0], name[1], plan[i].placement});
+  }
+  SaveHeadViews((fs::path(dir) / "views.yaml").string(), views);
 }
 
 rig::RigCalibration RenderHeadChessboards(const std::string& dir, const sim::SimRigConfig& config,

@@ -1,14 +1,18 @@
 // fovea calibrate: stereo calibration from chessboard image pairs, written as
 // the calibration file a hardware rig reads; fovea chessboards: a synthetic
 // set of such pairs rendered by the simulator, with the true values.
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdio>
+#include <iostream>
 #include <optional>
 
 #include "commands.h"
 #include "experiments/calibration/calibration.h"
 #include "experiments/calibration/head_calibration.h"
 #include "experiments/output/output.h"
+#include "hardware_setup.h"
 #include "scene_options.h"
 
 namespace experiments {
@@ -144,6 +148,8 @@ void AddCalibrateCommands(CLI::App& app, std::function<int()>* run) {
     std::string config_path;
     std::vector<std::string> set;
     std::string seed;
+    std::string states;
+    bool no_wait = false;
   };
   auto hs = std::make_shared<HeadSet>();
   CLI::App* gen = app.add_subcommand("chessboards",
@@ -163,10 +169,43 @@ void AddCalibrateCommands(CLI::App& app, std::function<int()>* run) {
                   "with --head: YAML configuration of the rig (its imperfections: rig.*)");
   gen->add_option("--set", hs->set, "with --head: KEY=VALUE, one rig parameter (repeatable)");
   gen->add_option("--seed", hs->seed, "with --head: seed of the stage states and sensor noise");
+  gen->add_option("--states", hs->states,
+                  "with --head: capture with the config's rig (rig.type hardware, or its simulated "
+                  "scene) at the stage states this views.yaml lists, instead of rendering boards");
+  gen->add_flag("--no-wait", hs->no_wait,
+                "with --states: do not wait for Enter before each board placement");
   gen->callback([dir, views, square, force, hs, run] {
     *run = [dir, views, square, force, hs] {
-      if (!hs->head && (!hs->config_path.empty() || !hs->set.empty() || !hs->seed.empty()))
-        throw UsageError("--config, --set and --seed go with --head");
+      if (!hs->head && (!hs->config_path.empty() || !hs->set.empty() || !hs->seed.empty() ||
+                        !hs->states.empty()))
+        throw UsageError("--config, --set, --seed and --states go with --head");
+      if (hs->head && !hs->states.empty()) {
+        RunConfig c = hs->config_path.empty() ? RunConfig{} : LoadConfig(hs->config_path);
+        SetParams(&c, hs->set);
+        if (!hs->seed.empty()) SetParamFromFlag(&c, "--seed", "seed", hs->seed);
+        c.Check();
+        const std::vector<HeadView> plan = LoadHeadViews(hs->states, /*images=*/false);
+        std::unique_ptr<rig::IndexerEmulator> emulator;
+        std::unique_ptr<rig::HardwareRig> hardware;
+        std::unique_ptr<sim::Simulation> sim;
+        if (c.hardware.type == "hardware")
+          hardware = MakeHardwareRig(c, &emulator);
+        else
+          sim = LoadSceneOf(c);
+        rig::Rig& rig = hardware ? static_cast<rig::Rig&>(*hardware) : sim->rig();
+        const bool wait = !hs->no_wait && isatty(STDIN_FILENO);
+        OutputFolder folder(*dir, "--out", ExistingPolicy(*force));
+        CaptureHeadViews(rig, plan, folder.path(), [wait](int placement) {
+          if (!wait) return;
+          std::printf("place the board at placement %d, then press Enter: ", placement);
+          std::fflush(stdout);
+          std::string line;
+          std::getline(std::cin, line);
+        });
+        folder.Commit();
+        std::printf("%zu views captured -> %s/views.yaml\n", plan.size(), dir->c_str());
+        return 0;
+      }
       if (hs->head) {
         RunConfig c = hs->config_path.empty() ? RunConfig{} : LoadConfig(hs->config_path);
         SetParams(&c, hs->set);

@@ -6,10 +6,12 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "rig/calibration.h"
+#include "rig/rig.h"
 #include "sim/config.h"
 
 namespace experiments {
@@ -26,7 +28,9 @@ struct HeadView {
 /// Reads views.yaml: `views:` a list of {left, right, placement, state: [6
 /// numbers, metres and radians in StageState::ToArray order]}; image paths
 /// relative to the file's folder. Throws UsageError naming the file and entry.
-std::vector<HeadView> LoadHeadViews(const std::string& path);
+/// With `images` false, the images may be absent (a plan of stage states
+/// to capture at).
+std::vector<HeadView> LoadHeadViews(const std::string& path, bool images = true);
 /// Writes views.yaml (atomically), image paths as given.
 void SaveHeadViews(const std::string& path, const std::vector<HeadView>& views);
 
@@ -57,6 +61,15 @@ struct HeadCalibrationResult {
 /// chain the views cannot determine (naming the parameter and what to vary).
 HeadCalibrationResult CalibrateHead(const std::vector<HeadView>& views, int cols, int rows,
                                     double square_m);
+
+/// Captures a head-calibration set with any rig: for each entry of `plan` in
+/// order, moves to its stage state, grabs a raw pair (distortion kept) and
+/// writes left_NN.png, right_NN.png; then views.yaml with the readings the
+/// stages report and each entry's placement. `before_placement` is called
+/// before the first view of each placement (to let someone move the board).
+/// Throws rig::RigError for a state the rig refuses or a failed capture.
+void CaptureHeadViews(rig::Rig& rig, const std::vector<HeadView>& plan, const std::string& dir,
+                      const std::function<void(int placement)>& before_placement);
 
 /// Renders a head-calibration set with the simulated rig `config` (its
 /// imperfections included): `placements` board placements (9 x 6 inner
