@@ -41,14 +41,19 @@ sweep calibrated "$rig_keys
 # Means over the six runs of each rig, from each run's summary.json (a run
 # that mapped nothing has null errors: counted as missing).
 echo
-printf '%-11s %-16s %9s %9s %9s %14s %10s %9s %9s\n' rig scene coverage good idr_cov \
-  median_err_mm rel_err_% attempts refused
+printf '%-11s %-16s %9s %9s %9s %14s %10s %9s %9s %12s\n' rig scene coverage good idr_cov \
+  median_err_mm rel_err_% attempts refused servo_steps
 for rig in ideal design calibrated; do
   for scene in cylinder_planes three_surfaces all; do
   pattern=$scene
   [ "$scene" = all ] && pattern=.
-  grep -l "^  \"scene\": \".*$pattern" "$out/$rig"/runs/*/summary.json | xargs cat |
-    awk -v rig="$rig" -v scene="$scene" '
+  summaries=$(grep -l "^  \"scene\": \".*$pattern" "$out/$rig"/runs/*/summary.json)
+  # Servo iterations per servoed attempt, from the runs' fixation records.
+  steps=$(for f in $summaries; do cat "${f%summary.json}fixations.jsonl"; done |
+    grep -o '"servo":{[^}]*}' | grep -o '"iterations":[0-9]*' | cut -d: -f2 |
+    awk '{ s += $1; n++ } END { if (n) printf "%.2f", s / n; else printf "-" }')
+  cat $summaries |
+    awk -v rig="$rig" -v scene="$scene" -v steps="$steps" '
     function add(name, v) { if (v != "null") { sum[name] += v; n[name]++ } }
     function value() { v = $2; sub(/,$/, "", v); return v }
     /^  "idr": \{/ { in_idr = 1 }
@@ -61,7 +66,8 @@ for rig in ideal design calibrated; do
     /^  "attempts":/ { add("attempts", value()) }
     /^  "refused":/ { add("refused", value()) }
     function m(name) { return n[name] ? sum[name] / n[name] : -1 }
-    END { printf "%-11s %-16s %9.3f %9.3f %9.3f %14.2f %10.3f %9.1f %9.1f\n", rig, scene,
-          m("coverage"), m("good"), m("idr"), m("med"), m("rel"), m("attempts"), m("refused") }'
+    END { printf "%-11s %-16s %9.3f %9.3f %9.3f %14.2f %10.3f %9.1f %9.1f %12s\n", rig, scene,
+          m("coverage"), m("good"), m("idr"), m("med"), m("rel"), m("attempts"), m("refused"),
+          steps }'
   done
 done
