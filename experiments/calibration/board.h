@@ -22,7 +22,9 @@ bool FindBoard(const cv::Mat& img, const cv::Size& pattern, std::vector<cv::Poin
 void CheckBoardSize(const cv::Mat& img, const cv::Size& pattern, const std::string& file);
 rig::CameraIntrinsics IntrinsicsOf(const cv::Mat& k, const cv::Mat& dist, const cv::Size& size);
 /// Board coordinates of the inner corners, row by row, metres (z = 0).
-std::vector<cv::Point3f> Corners(int cols, int rows, double square_m);
+/// Throws UsageError, prefixed by `command`, unless the board has at least
+/// 2x2 inner corners and a positive square.
+std::vector<cv::Point3f> Corners(const char* command, int cols, int rows, double square_m);
 /// Creates `dir` and a scene folder inside it holding the board's texture
 /// (chessboard.png, for SceneXml); returns the scene folder's path, which
 /// the caller removes when done.

@@ -132,7 +132,10 @@ rig::CameraIntrinsics IntrinsicsOf(const cv::Mat& k, const cv::Mat& dist, const 
   return ki;
 }
 
-std::vector<cv::Point3f> Corners(int cols, int rows, double square_m) {
+std::vector<cv::Point3f> Corners(const char* command, int cols, int rows, double square_m) {
+  if (cols < 2 || rows < 2 || !(square_m > 0))
+    throw UsageError(std::string(command) +
+                     ": --board needs at least 2x2 inner corners and --square a positive size");
   std::vector<cv::Point3f> board;
   for (int r = 0; r < rows; ++r)
     for (int c = 0; c < cols; ++c)
@@ -186,11 +189,8 @@ CalibrationResult CalibrateStereo(const std::vector<std::string>& left_files,
   if (left_files.size() != right_files.size())
     throw UsageError("calibrate: " + std::to_string(left_files.size()) + " left images but " +
                      std::to_string(right_files.size()) + " right ones");
-  if (cols < 2 || rows < 2 || !(square_m > 0))
-    throw UsageError(
-        "calibrate: --board needs at least 2x2 inner corners and --square a positive size");
+  const std::vector<cv::Point3f> board = board::Corners("calibrate", cols, rows, square_m);
   const cv::Size pattern(cols, rows);
-  const std::vector<cv::Point3f> board = board::Corners(cols, rows, square_m);
   CalibrationResult result;
   std::vector<std::vector<cv::Point3f>> object;
   std::vector<std::vector<cv::Point2f>> points[2];

@@ -44,15 +44,13 @@ Eigen::Isometry3d FromRvecTvec(const cv::Mat& rvec, const cv::Mat& tvec) {
   return T;
 }
 
-// The tilt frame at the readings, zeros not applied (what hand-eye calls
-// the gripper): rail zero at the origin.
+// The tilt frame at the readings (what hand-eye calls the gripper): the
+// rig's kinematics with a pan zero, no tilt zero (the mount carries it), the
+// rail zero at the origin.
 Eigen::Isometry3d WorldFromTilt(const rig::CameraStage& s, double pan_zero_rad) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.translation() = s.carriage_m * Eigen::Vector3d::UnitX();
-  T.linear() = (Eigen::AngleAxisd(s.pan_rad + pan_zero_rad, Eigen::Vector3d::UnitZ()) *
-                Eigen::AngleAxisd(s.tilt_rad, Eigen::Vector3d::UnitX()))
-                   .toRotationMatrix();
-  return T;
+  rig::RigGeometry g;
+  g.left.pan_zero_rad = pan_zero_rad;
+  return g.WorldFromHead(rig::Side::kLeft, s);
 }
 
 // The joint model: per camera 16 parameters, per board placement 6.
@@ -226,11 +224,7 @@ std::string Short(double v) {
   return t;
 }
 
-std::string Degrees(double rad) {
-  char t[32];
-  std::snprintf(t, sizeof t, "%.3g", rad / kDeg);
-  return t;
-}
+std::string Degrees(double rad) { return Short(rad / kDeg); }
 
 }  // namespace
 
@@ -296,11 +290,8 @@ void SaveHeadViews(const std::string& path, const std::vector<HeadView>& views) 
 
 HeadCalibrationResult CalibrateHead(const std::vector<HeadView>& views, int cols, int rows,
                                     double square_m) {
-  if (cols < 2 || rows < 2 || !(square_m > 0))
-    throw UsageError(
-        "calibrate-head: --board needs at least 2x2 inner corners and --square a positive size");
+  const std::vector<cv::Point3f> board = board::Corners("calibrate-head", cols, rows, square_m);
   const cv::Size pattern(cols, rows);
-  const std::vector<cv::Point3f> board = board::Corners(cols, rows, square_m);
   HeadCalibrationResult result;
   Model model;
   model.views = &views;

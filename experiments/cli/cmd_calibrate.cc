@@ -179,11 +179,15 @@ void AddCalibrateCommands(CLI::App& app, std::function<int()>* run) {
       if (!hs->head && (!hs->config_path.empty() || !hs->set.empty() || !hs->seed.empty() ||
                         !hs->states.empty()))
         throw UsageError("--config, --set, --seed and --states go with --head");
-      if (hs->head && !hs->states.empty()) {
-        RunConfig c = hs->config_path.empty() ? RunConfig{} : LoadConfig(hs->config_path);
+      // The rig's configuration (--head): the file, then --set, then --seed.
+      RunConfig c;
+      if (hs->head) {
+        if (!hs->config_path.empty()) c = LoadConfig(hs->config_path);
         SetParams(&c, hs->set);
         if (!hs->seed.empty()) SetParamFromFlag(&c, "--seed", "seed", hs->seed);
         c.Check();
+      }
+      if (hs->head && !hs->states.empty()) {
         const std::vector<HeadView> plan = LoadHeadViews(hs->states, /*images=*/false);
         std::unique_ptr<rig::IndexerEmulator> emulator;
         std::unique_ptr<rig::HardwareRig> hardware;
@@ -207,10 +211,6 @@ void AddCalibrateCommands(CLI::App& app, std::function<int()>* run) {
         return 0;
       }
       if (hs->head) {
-        RunConfig c = hs->config_path.empty() ? RunConfig{} : LoadConfig(hs->config_path);
-        SetParams(&c, hs->set);
-        if (!hs->seed.empty()) SetParamFromFlag(&c, "--seed", "seed", hs->seed);
-        c.Check();
         OutputFolder folder(*dir, "--out", ExistingPolicy(*force));
         const rig::RigCalibration truth =
             RenderHeadChessboards(folder.path(), c.rig, hs->placements, *views, *square, c.seed);

@@ -11,12 +11,7 @@ std::unique_ptr<rig::HardwareRig> MakeHardwareRig(const RunConfig& c,
   const RunConfig::Hardware& h = c.hardware;
   rig::HardwareRigConfig hw;
   hw.calibration = rig::LoadCalibration(c.rig.calibration);
-  for (const rig::CameraIntrinsics* k : {&hw.calibration.left, &hw.calibration.right})
-    if (k->width_px != c.rig.width_px || k->height_px != c.rig.height_px)
-      throw rig::InputError("calibration " + rig::ClipForMessage(c.rig.calibration) + " is for " +
-                            std::to_string(k->width_px) + "x" + std::to_string(k->height_px) +
-                            " images, rig.width_px x rig.height_px is " +
-                            std::to_string(c.rig.width_px) + "x" + std::to_string(c.rig.height_px));
+  rig::CheckCalibrationSize(hw.calibration, c.rig.calibration, c.rig.width_px, c.rig.height_px);
   const double lin = c.rig.baseline_steps_per_mm * 1000,
                ang = c.rig.pan_tilt_steps_per_deg * 180 / M_PI;
   const double pan = c.rig.pan_limit_deg * M_PI / 180, tilt = c.rig.tilt_limit_deg * M_PI / 180;

@@ -39,6 +39,14 @@ double RotationAngle(const Eigen::Matrix3d& R) {
   return std::acos(std::clamp(0.5 * (R.trace() - 1), -1.0, 1.0));
 }
 
+// Whether turning a camera of intrinsics k by `angle` (radians) moves no
+// pixel by a hundredth of a pixel at the farthest corner: not worth resampling.
+bool MovesNoPixel(const rig::CameraIntrinsics& k, double angle) {
+  const double corner =
+      std::hypot(std::max(k.cx_px, k.width_px - k.cx_px), std::max(k.cy_px, k.height_px - k.cy_px));
+  return angle * std::max(corner, k.fx_px) < 0.01;
+}
+
 rig::CameraView TurnView(const rig::CameraView& view, const Eigen::Matrix3d& rolled, cv::Matx33d* H,
                          int border = cv::BORDER_CONSTANT) {
   const cv::Matx33d K = CameraMatrix(view.intrinsics);
@@ -78,13 +86,9 @@ FixationFrame ToFixationFrame(const rig::StereoFrame& frame) {
   const Eigen::Matrix3d tl = IntoPlane(left, normal.normalized(), &f.left_roll_rad, &left_turn);
   const Eigen::Matrix3d tr =
       IntoPlane(right, normal.normalized(), &f.right_roll_rad, &f.right_turn_rad);
-  // Under a hundredth of a pixel at the farthest corner: not worth resampling.
-  const auto& k = frame.left.intrinsics;
-  const double corner =
-      std::hypot(std::max(k.cx_px, k.width_px - k.cx_px), std::max(k.cy_px, k.height_px - k.cy_px));
   const double angle =
       std::max(RotationAngle(tl.transpose() * left), RotationAngle(tr.transpose() * right));
-  if (angle * std::max(corner, k.fx_px) < 0.01) {
+  if (MovesNoPixel(frame.left.intrinsics, angle)) {
     FixationFrame same = OriginalFrame(frame);
     same.left_roll_rad = f.left_roll_rad;
     same.right_roll_rad = f.right_roll_rad;
@@ -107,9 +111,6 @@ FixationFrame ToFixationFrame(const rig::StereoFrame& frame) {
 rig::StereoFrame ToParallelFrame(const rig::StereoFrame& frame) {
   const Eigen::Matrix3d& left = frame.left.world_T_camera.linear();
   const Eigen::Matrix3d& right = frame.right.world_T_camera.linear();
-  const Eigen::Vector3d baseline =
-      frame.right.world_T_camera.translation() - frame.left.world_T_camera.translation();
-  if (baseline.norm() < 1e-9) return frame;
   // x along the rail (world X), not along the centres' offset: cameras
   // that sit off their axes are turned differently, so their centres also
   // differ forward and up by millimetres, which at IDR's smallest baselines
@@ -120,12 +121,9 @@ rig::StereoFrame ToParallelFrame(const rig::StereoFrame& frame) {
   rect.col(0) = Eigen::Vector3d::UnitX();
   rect.col(2) = (left.col(2) - rect.col(0).dot(left.col(2)) * rect.col(0)).normalized();
   rect.col(1) = rect.col(2).cross(rect.col(0));
-  const auto& k = frame.left.intrinsics;
-  const double corner =
-      std::hypot(std::max(k.cx_px, k.width_px - k.cx_px), std::max(k.cy_px, k.height_px - k.cy_px));
   const double angle =
       std::max(RotationAngle(rect.transpose() * left), RotationAngle(rect.transpose() * right));
-  if (angle * std::max(corner, k.fx_px) < 0.01) return frame;
+  if (MovesNoPixel(frame.left.intrinsics, angle)) return frame;
   rig::StereoFrame out;
   out.state = frame.state;
   out.timestamp_s = frame.timestamp_s;

@@ -111,6 +111,24 @@ RigCalibration LoadCalibration(const std::string& path) {
   return c;
 }
 
+RigGeometry RigCalibration::Geometry() const {
+  RigGeometry g;
+  g.left = left_head;
+  g.right = right_head;
+  g.left.rail_zero_W = g.right.rail_zero_W = Eigen::Vector3d::Zero();
+  return g;
+}
+
+void CheckCalibrationSize(const RigCalibration& c, const std::string& path, int width_px,
+                          int height_px) {
+  for (const CameraIntrinsics* k : {&c.left, &c.right})
+    if (k->width_px != width_px || k->height_px != height_px)
+      throw InputError("calibration " + ClipForMessage(path) + " is for " +
+                       std::to_string(k->width_px) + "x" + std::to_string(k->height_px) +
+                       " images, rig.width_px x rig.height_px is " + std::to_string(width_px) +
+                       "x" + std::to_string(height_px));
+}
+
 void SaveCalibration(const std::string& path, const RigCalibration& c) {
   cv::FileStorage fs(path, cv::FileStorage::WRITE | cv::FileStorage::FORMAT_YAML);
   if (!fs.isOpened()) throw RigError("calibration " + path + ": cannot be written");

@@ -21,12 +21,16 @@ Eigen::Matrix3d HeadGeometry::MountRotation() const {
       .toRotationMatrix();
 }
 
-Eigen::Isometry3d HeadGeometry::HeadFromCamera() const {
+Eigen::Isometry3d HeadGeometry::MountPose() const {
   Eigen::Isometry3d head_T_camera = Eigen::Isometry3d::Identity();
   head_T_camera.translation() = optical_centre_H;
   head_T_camera.linear() = MountRotation() * HeadFromCameraRotation();
+  return head_T_camera;
+}
+
+Eigen::Isometry3d HeadGeometry::HeadFromCamera() const {
   const Eigen::Isometry3d tilt_zero(Eigen::AngleAxisd(tilt_zero_rad, Eigen::Vector3d::UnitX()));
-  return tilt_zero * head_T_camera;
+  return tilt_zero * MountPose();
 }
 
 HeadGeometry HeadGeometry::FoldTiltZero() const {
@@ -72,7 +76,7 @@ CameraStage RigGeometry::ParallelStage(Side side, double carriage_m) const {
   // The optical axis in the head frame at zero readings, before the zeros:
   // Rz(p + pan_zero) Rx(t + tilt_zero) d = +y. Tilt first lays d level
   // (its z to 0), then pan turns it forward.
-  const Eigen::Vector3d d = head.MountRotation() * HeadFromCameraRotation().col(2);
+  const Eigen::Vector3d d = head.MountPose().linear().col(2);
   const double tilt = std::atan2(-d.z(), d.y());
   const double level_y = d.y() * std::cos(tilt) - d.z() * std::sin(tilt);
   const double pan = std::atan2(d.x(), level_y);
@@ -81,11 +85,7 @@ CameraStage RigGeometry::ParallelStage(Side side, double carriage_m) const {
 
 Eigen::Isometry3d RigGeometry::WorldFromCamera(Side side, const CameraStage& stage) const {
   // WorldFromHead turns by the tilt zero already: the mount alone here.
-  const HeadGeometry& head = (*this)[side];
-  Eigen::Isometry3d head_T_camera = Eigen::Isometry3d::Identity();
-  head_T_camera.translation() = head.optical_centre_H;
-  head_T_camera.linear() = head.MountRotation() * HeadFromCameraRotation();
-  return WorldFromHead(side, stage) * head_T_camera;
+  return WorldFromHead(side, stage) * (*this)[side].MountPose();
 }
 
 }  // namespace rig

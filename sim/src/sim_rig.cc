@@ -106,39 +106,27 @@ SimRig::SimRig(World* world, const SimRigConfig& config)
   limits_[Axis::kLeftPan] = limits_[Axis::kRightPan] = {-pan, pan, ang_steps};
   limits_[Axis::kLeftTilt] = limits_[Axis::kRightTilt] = {-tilt, tilt, ang_steps};
   // The belief: a calibration file, else the design.
-  const rig::CameraIntrinsics ideal = rig::CameraIntrinsics::FromHorizontalFov(
-      config.width_px, config.height_px, config.horizontal_fov_deg * kDegToRad);
+  const rig::CameraIntrinsics true_k = TrueIntrinsics(config);
+  const rig::CameraIntrinsics ideal = rig::Undistorter::Pinhole(true_k);
   rig::RigCalibration belief;
   if (!config.calibration.empty()) {
     belief = rig::LoadCalibration(config.calibration);
-    for (rig::Side side : {rig::Side::kLeft, rig::Side::kRight}) {
-      const rig::CameraIntrinsics& k = belief.Intrinsics(side);
-      if (k.width_px != config.width_px || k.height_px != config.height_px)
-        throw rig::InputError(
-            "calibration " + rig::ClipForMessage(config.calibration) + " is for " +
-            std::to_string(k.width_px) + "x" + std::to_string(k.height_px) +
-            " images, rig.width_px x rig.height_px is " + std::to_string(config.width_px) + "x" +
-            std::to_string(config.height_px));
-    }
+    rig::CheckCalibrationSize(belief, config.calibration, config.width_px, config.height_px);
   } else {
     belief.left = belief.right = ideal;
     belief.left_head.optical_centre_H = belief.right_head.optical_centre_H =
         config.optical_centre_offset_m;
   }
-  geometry_.left = belief.left_head;
-  geometry_.right = belief.right_head;
-  geometry_.left.rail_zero_W = geometry_.right.rail_zero_W = Eigen::Vector3d::Zero();
+  geometry_ = belief.Geometry();
 
   // The truth's lens and sensor, and how delivered pixels relate to it.
-  const rig::CameraIntrinsics true_k = TrueIntrinsics(config);
   render_size_ = RenderSize(config);
   if (!true_k.distortion.empty()) {
-    const cv::Size render = render_size_;
     rig::CameraIntrinsics wide = ideal;
-    wide.width_px = render.width;
-    wide.height_px = render.height;
-    wide.cx_px = 0.5 * (render.width - 1);
-    wide.cy_px = 0.5 * (render.height - 1);
+    wide.width_px = render_size_.width;
+    wide.height_px = render_size_.height;
+    wide.cx_px = 0.5 * (render_size_.width - 1);
+    wide.cy_px = 0.5 * (render_size_.height - 1);
     PixelMaps({{true_k, wide}}, &distort_x_, &distort_y_);
   }
   const Imperfections& im = config.imperfections;
@@ -244,8 +232,7 @@ SimRig::TrueCamera SimRig::True(rig::Side side) const {
   const int s = static_cast<int>(side);
   TrueCamera t;
   t.world_T_camera = CameraPoseFromMujoco(world_->d, world_->camera_ids[s]);
-  t.ideal = rig::CameraIntrinsics::FromHorizontalFov(config_.width_px, config_.height_px,
-                                                     config_.horizontal_fov_deg * kDegToRad);
+  t.ideal = rig::Undistorter::Pinhole(TrueIntrinsics(config_));
   t.map_x = delivered_x_[s];
   t.map_y = delivered_y_[s];
   return t;

@@ -86,9 +86,7 @@ HardwareRig::HardwareRig(HardwareRigConfig config) : calibration_(config.calibra
     const IndexerAxis& a = config.stages.axes[i];
     limits_.axes[i] = {a.min, a.max, a.steps_per_unit};
   }
-  geometry_.left = calibration_.left_head;
-  geometry_.right = calibration_.right_head;
-  geometry_.left.rail_zero_W = geometry_.right.rail_zero_W = Eigen::Vector3d::Zero();
+  geometry_ = calibration_.Geometry();
   home_ = limits_.Quantize(StageState::Parallel(config.home_baseline_m));
   undistort_[0] = Undistorter(calibration_.left);
   undistort_[1] = Undistorter(calibration_.right);

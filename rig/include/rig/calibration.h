@@ -28,11 +28,18 @@ struct RigCalibration {
 
   const CameraIntrinsics& Intrinsics(Side side) const { return side == Side::kLeft ? left : right; }
   const HeadGeometry& Head(Side side) const { return side == Side::kLeft ? left_head : right_head; }
+  /// The rig's kinematics as this calibration has it: both heads, their
+  /// rail zeros at the world origin (the rail's centre).
+  RigGeometry Geometry() const;
 };
 /// Reads a calibration file (a regular file of at most 64 MiB, OpenCV YAML,
 /// format version 1 or 2). Throws InputError naming the file and the
 /// missing or bad entry, or a version newer than kCalibrationVersion.
 RigCalibration LoadCalibration(const std::string& path);
 void SaveCalibration(const std::string& path, const RigCalibration& calibration);
+/// Throws InputError unless both cameras of `calibration` (read from
+/// `path`) are for images of width_px x height_px (rig.width_px, rig.height_px).
+void CheckCalibrationSize(const RigCalibration& calibration, const std::string& path, int width_px,
+                          int height_px);
 
 }  // namespace rig

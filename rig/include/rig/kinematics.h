@@ -33,6 +33,8 @@ struct HeadGeometry {
 
   /// R_mount from mount_rpy_rad.
   Eigen::Matrix3d MountRotation() const;
+  /// The mount alone: Translation(optical_centre_H) * R_mount * R_head_camera.
+  Eigen::Isometry3d MountPose() const;
   /// head_T_camera at pan = tilt = 0 (readings), the zeros included: the
   /// camera's pose in the head frame that a calibration can observe.
   Eigen::Isometry3d HeadFromCamera() const;
