@@ -241,7 +241,9 @@ SimRig::TrueCamera SimRig::True(rig::Side side) const {
 void SimRig::ApplyOptics(int side, cv::Mat* image) const {
   if (!distort_x_.empty()) {
     cv::Mat distorted;
-    cv::remap(*image, distorted, distort_x_, distort_y_, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+    // Bicubic: a lens does not blur as a bilinear resampling of the render
+    // would, on top of the undistortion's own resampling.
+    cv::remap(*image, distorted, distort_x_, distort_y_, cv::INTER_CUBIC, cv::BORDER_REPLICATE);
     *image = distorted;
   }
   const double offset = config_.imperfections[static_cast<rig::Side>(side)].offset_dn;

@@ -20,7 +20,7 @@ class Undistorter {
 
   /// Whether the camera has any distortion to remove.
   bool Active() const { return !map_x_.empty(); }
-  /// The undistorted image (bilinear); `raw` itself when not Active().
+  /// The undistorted image (bicubic); `raw` itself when not Active().
   cv::Mat Apply(const cv::Mat& raw) const;
   /// `k` without its distortion: what an undistorted frame reports.
   static CameraIntrinsics Pinhole(const CameraIntrinsics& k);
