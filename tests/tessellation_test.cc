@@ -206,6 +206,47 @@ TEST_CASE("a level verged pair is its own fixation frame",
   CHECK(size_t(cv::countNonZero(f.left_valid)) == f.left_valid.total());
 }
 
+TEST_CASE("the fixation frame gives both cameras one pixel grid when their intrinsics differ",
+          "[fovea][tessellation][fixation_frame]") {
+  // A calibrated pair: the right principal point 0.7 px lower, its focal
+  // length 0.1% longer. Rows of one image are no longer rows of the other:
+  // the tessellation reads 0.7 px of vertical disparity at the fixation
+  // and the fovea shrinks to its floor. The fixation frame resamples the
+  // right image onto the left camera's grid.
+  rig::StereoFrame level = VergedFrame({0.02, 0.9, 0.01}, 0.12);
+  const Eigen::Vector3d fixation = {0.02, 0.9, 0.01};
+  rig::CameraIntrinsics& kr = level.right.intrinsics;
+  kr.cy_px += 0.7;
+  kr.fx_px *= 1.001;
+  kr.fy_px *= 1.001;
+  const fovea::FixationFrame f = fovea::ToFixationFrame(level);
+  REQUIRE(f.resampled);
+  const rig::CameraIntrinsics& kl = f.views.left.intrinsics;
+  for (const rig::CameraIntrinsics* k : {&f.views.left.intrinsics, &f.views.right.intrinsics}) {
+    CHECK(k->fx_px == kl.fx_px);
+    CHECK(k->fy_px == kl.fy_px);
+    CHECK(k->cx_px == kl.cx_px);
+    CHECK(k->cy_px == kl.cy_px);
+  }
+  // H still carries a world point's original pixel to its new one.
+  const Eigen::Vector3d p(0.1, 1.0, 0.08);
+  const auto uv = fovea::ProjectWorldPoint(level.right.world_T_camera, kr, p);
+  const auto uv_f = fovea::ProjectWorldPoint(f.views.right.world_T_camera, kl, p);
+  REQUIRE((uv && uv_f));
+  const cv::Point2d mapped = fovea::MapPixels(f.right_H, {{uv->x(), uv->y()}})[0];
+  CHECK(mapped.x == Approx(uv_f->x()).margin(1e-6));
+  CHECK(mapped.y == Approx(uv_f->y()).margin(1e-6));
+  auto fovea_area = [&](const rig::StereoFrame& s) {
+    return fovea::Tessellate(s.left, s.right, fixation, {}, {}).rects.at(0).area();
+  };
+  const rig::StereoFrame same = VergedFrame(fixation, 0.12);
+  INFO("fovea: equal intrinsics " << fovea_area(same) << " px, differing " << fovea_area(level)
+                                  << " px unrectified, " << fovea_area(f.views)
+                                  << " px in the fixation frame");
+  CHECK(fovea_area(level) < 0.1 * fovea_area(same));
+  CHECK(fovea_area(f.views) >= 0.95 * fovea_area(same));
+}
+
 TEST_CASE("in the fixation frame the optical axes meet after the right camera pans",
           "[fovea][tessellation][fixation_frame]") {
   // The servo pans the tilted right camera about the vertical: its axis

@@ -47,19 +47,37 @@ bool MovesNoPixel(const rig::CameraIntrinsics& k, double angle) {
   return angle * std::max(corner, k.fx_px) < 0.01;
 }
 
-rig::CameraView TurnView(const rig::CameraView& view, const Eigen::Matrix3d& rolled, cv::Matx33d* H,
+// The largest distance any image corner moves when pixels of camera `from`
+// are given camera `to`'s intrinsics (same rays): how far apart two
+// cameras' pixel grids lie.
+double IntrinsicsShiftPx(const rig::CameraIntrinsics& from, const rig::CameraIntrinsics& to) {
+  const cv::Matx33d M = CameraMatrix(to) * CameraMatrix(from).inv();
+  double most = 0;
+  for (const double u : {0.0, from.width_px - 1.0})
+    for (const double v : {0.0, from.height_px - 1.0}) {
+      const cv::Vec3d q = M * cv::Vec3d(u, v, 1);
+      most = std::max(most, std::hypot(q[0] / q[2] - u, q[1] / q[2] - v));
+    }
+  return most;
+}
+
+// `view` turned to orientation `rolled` (about its optical centre) and given
+// the intrinsics `to`: both views of a pair get the left camera's, so that a
+// row of one is the same row of the other even when the cameras' principal
+// points or focal lengths differ (a calibrated pair's do, by a pixel).
+rig::CameraView TurnView(const rig::CameraView& view, const Eigen::Matrix3d& rolled,
+                         const rig::CameraIntrinsics& to, cv::Matx33d* H,
                          int border = cv::BORDER_CONSTANT) {
-  const cv::Matx33d K = CameraMatrix(view.intrinsics);
   const Eigen::Matrix3d R = rolled.transpose() * view.world_T_camera.linear();
   cv::Matx33d Rc;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) Rc(i, j) = R(i, j);
-  *H = K * Rc * K.inv();
+  *H = CameraMatrix(to) * Rc * CameraMatrix(view.intrinsics).inv();
   rig::CameraView out;
-  out.intrinsics = view.intrinsics;
+  out.intrinsics = to;
   out.world_T_camera = view.world_T_camera;
   out.world_T_camera.linear() = rolled;
-  const cv::Size size(view.intrinsics.width_px, view.intrinsics.height_px);
+  const cv::Size size(to.width_px, to.height_px);
   cv::warpPerspective(view.gray, out.gray, *H, size, cv::INTER_LINEAR, border);
   if (!view.bgr.empty()) cv::warpPerspective(view.bgr, out.bgr, *H, size, cv::INTER_LINEAR, border);
   return out;
@@ -88,7 +106,8 @@ FixationFrame ToFixationFrame(const rig::StereoFrame& frame) {
       IntoPlane(right, normal.normalized(), &f.right_roll_rad, &f.right_turn_rad);
   const double angle =
       std::max(RotationAngle(tl.transpose() * left), RotationAngle(tr.transpose() * right));
-  if (MovesNoPixel(frame.left.intrinsics, angle)) {
+  const rig::CameraIntrinsics& common = frame.left.intrinsics;
+  if (MovesNoPixel(common, angle) && IntrinsicsShiftPx(frame.right.intrinsics, common) < 0.01) {
     FixationFrame same = OriginalFrame(frame);
     same.left_roll_rad = f.left_roll_rad;
     same.right_roll_rad = f.right_roll_rad;
@@ -98,8 +117,8 @@ FixationFrame ToFixationFrame(const rig::StereoFrame& frame) {
   f.resampled = true;
   f.views.state = frame.state;
   f.views.timestamp_s = frame.timestamp_s;
-  f.views.left = TurnView(frame.left, tl, &f.left_H);
-  f.views.right = TurnView(frame.right, tr, &f.right_H);
+  f.views.left = TurnView(frame.left, tl, common, &f.left_H);
+  f.views.right = TurnView(frame.right, tr, common, &f.right_H);
   // Valid where every source pixel of the bilinear sample lies inside.
   const cv::Mat ones(frame.left.gray.size(), CV_8U, cv::Scalar(255));
   cv::warpPerspective(ones, f.left_valid, f.left_H, ones.size(), cv::INTER_LINEAR,
@@ -123,13 +142,15 @@ rig::StereoFrame ToParallelFrame(const rig::StereoFrame& frame) {
   rect.col(1) = rect.col(2).cross(rect.col(0));
   const double angle =
       std::max(RotationAngle(rect.transpose() * left), RotationAngle(rect.transpose() * right));
-  if (MovesNoPixel(frame.left.intrinsics, angle)) return frame;
+  const rig::CameraIntrinsics& common = frame.left.intrinsics;
+  if (MovesNoPixel(common, angle) && IntrinsicsShiftPx(frame.right.intrinsics, common) < 0.01)
+    return frame;
   rig::StereoFrame out;
   out.state = frame.state;
   out.timestamp_s = frame.timestamp_s;
   cv::Matx33d H;
-  out.left = TurnView(frame.left, rect, &H, cv::BORDER_REPLICATE);
-  out.right = TurnView(frame.right, rect, &H, cv::BORDER_REPLICATE);
+  out.left = TurnView(frame.left, rect, common, &H, cv::BORDER_REPLICATE);
+  out.right = TurnView(frame.right, rect, common, &H, cv::BORDER_REPLICATE);
   return out;
 }
 

@@ -27,7 +27,8 @@ namespace fovea {
 
 struct FixationFrame {
   /// The pair as matched: rolled images (grey, and BGR when present), rolled
-  /// poses, the original intrinsics and stage state.
+  /// poses, the stage state; when resampled, both views have the left
+  /// camera's intrinsics (rows of one are rows of the other).
   rig::StereoFrame views;
   /// Original pixel -> fixation-frame pixel, per camera (the homographies
   /// of the two rotations).
@@ -43,8 +44,8 @@ struct FixationFrame {
 };
 
 /// The fixation frame of a verged `frame`. Where the turns move no pixel by
-/// a hundredth of a pixel the images are not resampled (a level fixation
-/// matches exactly as before).
+/// a hundredth of a pixel and the two cameras' intrinsics agree as closely
+/// the images are not resampled (a level fixation matches exactly as before).
 FixationFrame ToFixationFrame(const rig::StereoFrame& frame);
 
 /// The original frame as the frame matched in (the paper's unrectified
@@ -55,10 +56,11 @@ FixationFrame OriginalFrame(const rig::StereoFrame& frame);
 /// software into an exactly parallel, rectified one: both views given the
 /// orientation whose x axis runs along the rail (world X) and whose z axis is the
 /// left camera's optical axis made perpendicular to it (y completing it),
-/// each image resampled through K R K^-1 (borders replicated). On an
+/// each image resampled through K_left R K^-1 (borders replicated; both
+/// given the left camera's intrinsics). On an
 /// imperfect rig this removes what the stages cannot: the mounts' roll and
-/// the steps' quantization. Returned as it is when no pixel would move by
-/// a hundredth of a pixel (an ideal rig).
+/// the steps' quantization and the cameras' differing intrinsics. Returned
+/// as it is when no pixel would move by a hundredth of a pixel (an ideal rig).
 rig::StereoFrame ToParallelFrame(const rig::StereoFrame& frame);
 
 /// Maps pixels through a 3x3 homography.
