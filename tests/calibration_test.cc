@@ -102,7 +102,40 @@ TEST_CASE("head calibration recovers a known imperfect rig", "[calibration][head
     CHECK((h.optical_centre_H - ht.optical_centre_H).norm() < 0.002);
     CHECK(std::abs(h.pan_zero_rad - ht.pan_zero_rad) * 180 / M_PI < 0.02);
   }
+  // What matters to a fixating pair: its depth. The ideal rig's own stereo
+  // error is about 0.06% of the depth; a calibration must add well under it.
+  const experiments::CalibrationDepthError e = experiments::DepthErrorAgainst(truth, r.calibration);
+  INFO("depth error at fixations: median " << 100 * e.median_rel << "%, p90 " << 100 * e.p90_rel
+                                           << "% over " << e.points << " points");
+  CHECK(e.points > 1000);
+  CHECK(e.median_rel < 0.0003);
   std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("the depth error a calibration makes follows the baseline and vergence it gets wrong",
+          "[calibration]") {
+  rig::RigCalibration truth;
+  truth.left = truth.right = rig::CameraIntrinsics::FromHorizontalFov(640, 480, 30 * M_PI / 180);
+  truth.left.distortion = truth.right.distortion = {-0.2, 0, 0, 0, 0};
+  truth.left_head.optical_centre_H = truth.right_head.optical_centre_H = {0.02, 0.08, 0.02};
+  truth.left_head.mount_rpy_rad = {0.02, 0.03, -0.01};
+  const experiments::CalibrationDepthError exact = experiments::DepthErrorAgainst(truth, truth);
+  CHECK(exact.points > 1000);
+  CHECK(exact.median_rel < 1e-9);
+  // Depth is baseline over vergence: 0.1 mm more believed baseline (of
+  // 0.06 m) is about 0.17% more depth everywhere; the right camera believed
+  // turned 0.01 degrees inward costs about depth x angle / baseline, 0.29%
+  // at 1 m (0.20% at 0.7 m, 0.38% at 1.3 m).
+  rig::RigCalibration wider = truth;
+  wider.right_head.optical_centre_H.x() += 1e-4;
+  const experiments::CalibrationDepthError b = experiments::DepthErrorAgainst(truth, wider);
+  CHECK(b.median_rel == Approx(1e-4 / 0.06).epsilon(0.2));
+  CHECK(b.p90_rel < 1.3 * b.median_rel);
+  rig::RigCalibration turned = truth;
+  turned.right_head.mount_rpy_rad.z() += 0.01 * M_PI / 180;
+  const experiments::CalibrationDepthError v = experiments::DepthErrorAgainst(truth, turned);
+  CHECK(v.median_rel == Approx(1.0 * 0.01 * M_PI / 180 / 0.06).epsilon(0.2));
+  CHECK(v.p90_rel > 1.2 * v.median_rel);
 }
 
 TEST_CASE("calibration files keep the head model (version 2) and still read version 1",

@@ -17,7 +17,7 @@ imperfect=$src/experiments/configs/imperfect-rig.yaml
 "$fovea" chessboards --head --config "$imperfect" --placements 4 --views 12 --square 0.02 \
   --out "$out/boards"
 "$fovea" calibrate-head --views "$out/boards/views.yaml" --board 9x6 --square 0.02 \
-  --out "$out/calibration.yaml"
+  --out "$out/calibration.yaml" --truth "$out/boards/truth.yaml"
 
 # One sweep per rig; the imperfect rig's keys copied under config: rig.
 rig_keys=$(sed -n '/^rig:/,$p' "$imperfect" | tail -n +2)
@@ -48,9 +48,10 @@ for rig in ideal design calibrated; do
   pattern=$scene
   [ "$scene" = all ] && pattern=.
   summaries=$(grep -l "^  \"scene\": \".*$pattern" "$out/$rig"/runs/*/summary.json)
-  # Servo iterations per servoed attempt, from the runs' fixation records.
+  # Servo iterations per servoed attempt, from the runs' fixation records
+  # (none when a rig mapped nothing: grep finds no servo, which is no error).
   steps=$(for f in $summaries; do cat "${f%summary.json}fixations.jsonl"; done |
-    grep -o '"servo":{[^}]*}' | grep -o '"iterations":[0-9]*' | cut -d: -f2 |
+    { grep -o '"servo":{[^}]*}' || true; } | { grep -o '"iterations":[0-9]*' || true; } | cut -d: -f2 |
     awk '{ s += $1; n++ } END { if (n) printf "%.2f", s / n; else printf "-" }')
   cat $summaries |
     awk -v rig="$rig" -v scene="$scene" -v steps="$steps" '

@@ -62,6 +62,23 @@ struct HeadCalibrationResult {
 HeadCalibrationResult CalibrateHead(const std::vector<HeadView>& views, int cols, int rows,
                                     double square_m);
 
+/// What a calibration's errors do to depth: a grid of points around
+/// fixation points 0.7 to 1.3 m ahead, within 15 degrees of straight ahead
+/// and 8 of level; the cameras verged on each through `belief`'s chain, 0.06
+/// m apart (a fixation's baseline); each point imaged by the `truth` rig,
+/// its pixels undistorted with `belief`'s lens and triangulated with
+/// `belief`'s chain. Relative error: the triangulated point's distance from
+/// the true one over the true one's distance from the left camera.
+struct CalibrationDepthError {
+  double median_rel = 0, p90_rel = 0;
+  /// How far the two believed rays miss each other at the point, as pixels
+  /// of the left camera there (vertical disparity after rectification).
+  double median_miss_px = 0, p90_miss_px = 0;
+  int points = 0;  ///< points both true cameras image
+};
+CalibrationDepthError DepthErrorAgainst(const rig::RigCalibration& truth,
+                                        const rig::RigCalibration& belief);
+
 /// Captures a head-calibration set with any rig: for each entry of `plan` in
 /// order, moves to its stage state, grabs a raw pair (distortion kept) and
 /// writes left_NN.png, right_NN.png; then views.yaml with the readings the
