@@ -9,6 +9,7 @@
 #include <fstream>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
+#include <optional>
 #include <random>
 #include <set>
 #include <sstream>
@@ -16,6 +17,8 @@
 #include "board.h"
 #include "experiments/output/output.h"
 #include "experiments/usage_error.h"
+#include "fovea/geometry.h"
+#include "fovea/stats.h"
 #include "rig/input_file.h"
 #include "scenes/catalog.h"
 #include "sim/simulation.h"
@@ -533,60 +536,47 @@ CalibrationDepthError DepthErrorAgainst(const rig::RigCalibration& truth,
           true_pose[static_cast<int>(s)] = true_geometry.WorldFromCamera(s, stage);
           believed_pose[static_cast<int>(s)] = believed_geometry.WorldFromCamera(s, stage);
         }
+        // A camera's ray to q as the belief has it: the true lens's pixel,
+        // undistorted with the believed one; none where the true camera
+        // does not image q.
+        auto believed_ray = [&](int s, const Eigen::Vector3d& q) -> std::optional<fovea::Ray> {
+          const rig::CameraIntrinsics& t = s == 0 ? truth.left : truth.right;
+          const rig::CameraIntrinsics& b = s == 0 ? belief.left : belief.right;
+          const Eigen::Vector3d q_C = true_pose[s].inverse() * q;
+          if (q_C.z() <= 0) return std::nullopt;
+          std::vector<cv::Point2d> raw, delivered;
+          cv::projectPoints(std::vector<cv::Point3d>{{q_C.x(), q_C.y(), q_C.z()}},
+                            cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), cv::Mat(t.K()), t.distortion,
+                            raw);
+          if (raw[0].x < 0 || raw[0].y < 0 || raw[0].x >= t.width_px || raw[0].y >= t.height_px)
+            return std::nullopt;
+          cv::undistortPoints(raw, delivered, cv::Mat(b.K()), b.distortion);
+          return fovea::Ray{believed_pose[s].translation(),
+                            believed_pose[s].linear() *
+                                Eigen::Vector3d(delivered[0].x, delivered[0].y, 1).normalized()};
+        };
         for (int i = -2; i <= 2; ++i)
           for (int j = -2; j <= 2; ++j)
             for (int k = -1; k <= 1; ++k) {
               const Eigen::Vector3d q = p + Eigen::Vector3d(0.025 * i, 0.03 * k, 0.025 * j);
-              // Each camera's ray to q as the belief has it: the true
-              // lens's pixel, undistorted with the believed one.
-              std::array<Eigen::Vector3d, 2> ray;
-              bool seen = true;
-              for (int s = 0; s < 2 && seen; ++s) {
-                const rig::CameraIntrinsics& t = s == 0 ? truth.left : truth.right;
-                const rig::CameraIntrinsics& b = s == 0 ? belief.left : belief.right;
-                const Eigen::Vector3d q_C = true_pose[s].inverse() * q;
-                if (q_C.z() <= 0) {
-                  seen = false;
-                  break;
-                }
-                std::vector<cv::Point2d> raw, delivered;
-                cv::projectPoints(std::vector<cv::Point3d>{{q_C.x(), q_C.y(), q_C.z()}},
-                                  cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), cv::Mat(t.K()),
-                                  t.distortion, raw);
-                seen = raw[0].x >= 0 && raw[0].y >= 0 && raw[0].x < t.width_px &&
-                       raw[0].y < t.height_px;
-                cv::undistortPoints(raw, delivered, cv::Mat(b.K()), b.distortion);
-                ray[s] = believed_pose[s].linear() *
-                         Eigen::Vector3d(delivered[0].x, delivered[0].y, 1).normalized();
-              }
-              if (!seen) continue;
-              // The midpoint of the two rays' closest approach.
-              const Eigen::Vector3d o0 = believed_pose[0].translation();
-              const Eigen::Vector3d o1 = believed_pose[1].translation();
-              const double b = ray[0].dot(ray[1]), denom = 1 - b * b;
-              if (denom < 1e-12) continue;
-              const Eigen::Vector3d w = o0 - o1;
-              const double d0 = (b * ray[1].dot(w) - ray[0].dot(w)) / denom;
-              const double d1 = (ray[1].dot(w) - b * ray[0].dot(w)) / denom;
-              const Eigen::Vector3d estimate = 0.5 * (o0 + d0 * ray[0] + o1 + d1 * ray[1]);
-              errors.push_back((estimate - q).norm() / (q - true_pose[0].translation()).norm());
+              const std::optional<fovea::Ray> left = believed_ray(0, q), right = believed_ray(1, q);
+              if (!left || !right) continue;
+              const std::optional<fovea::Triangulation> t =
+                  fovea::TriangulateMidpoint(*left, *right);
+              if (!t) continue;
+              errors.push_back((t->p_W - q).norm() / (q - true_pose[0].translation()).norm());
               // How far the rays miss each other, as pixels at the point:
               // what a rectified pair shows as vertical disparity.
-              misses.push_back(((o0 + d0 * ray[0]) - (o1 + d1 * ray[1])).norm() / d0 *
+              misses.push_back(t->miss_distance_m / (t->p_W - left->origin_W).norm() *
                                belief.left.fx_px);
             }
       }
   CalibrationDepthError e;
   e.points = static_cast<int>(errors.size());
-  if (errors.empty()) return e;
-  auto quantile = [](std::vector<double>& v, double q) {
-    std::sort(v.begin(), v.end());
-    return v[std::min(v.size() - 1, static_cast<size_t>(q * v.size()))];
-  };
-  e.median_rel = quantile(errors, 0.5);
-  e.p90_rel = quantile(errors, 0.9);
-  e.median_miss_px = quantile(misses, 0.5);
-  e.p90_miss_px = quantile(misses, 0.9);
+  e.median_rel = fovea::Quantile(errors, 0.5);
+  e.p90_rel = fovea::Quantile(errors, 0.9);
+  e.median_miss_px = fovea::Quantile(misses, 0.5);
+  e.p90_miss_px = fovea::Quantile(misses, 0.9);
   return e;
 }
 

@@ -39,26 +39,23 @@ double RotationAngle(const Eigen::Matrix3d& R) {
   return std::acos(std::clamp(0.5 * (R.trace() - 1), -1.0, 1.0));
 }
 
-// Whether turning a camera of intrinsics k by `angle` (radians) moves no
-// pixel by a hundredth of a pixel at the farthest corner: not worth resampling.
-bool MovesNoPixel(const rig::CameraIntrinsics& k, double angle) {
+// Whether resampling `frame` to turn its cameras by at most `angle`
+// (radians) and give the right camera the left one's intrinsics would move
+// no pixel by a hundredth of a pixel at the farthest corner: not worth it.
+bool MovesNoPixel(const rig::StereoFrame& frame, double angle) {
+  const rig::CameraIntrinsics& k = frame.left.intrinsics;
   const double corner =
       std::hypot(std::max(k.cx_px, k.width_px - k.cx_px), std::max(k.cy_px, k.height_px - k.cy_px));
-  return angle * std::max(corner, k.fx_px) < 0.01;
-}
-
-// The largest distance any image corner moves when pixels of camera `from`
-// are given camera `to`'s intrinsics (same rays): how far apart two
-// cameras' pixel grids lie.
-double IntrinsicsShiftPx(const rig::CameraIntrinsics& from, const rig::CameraIntrinsics& to) {
-  const cv::Matx33d M = CameraMatrix(to) * CameraMatrix(from).inv();
-  double most = 0;
-  for (const double u : {0.0, from.width_px - 1.0})
-    for (const double v : {0.0, from.height_px - 1.0}) {
+  if (angle * std::max(corner, k.fx_px) >= 0.01) return false;
+  // Where the right camera's corners land on the left camera's pixel grid.
+  const rig::CameraIntrinsics& r = frame.right.intrinsics;
+  const cv::Matx33d M = CameraMatrix(k) * CameraMatrix(r).inv();
+  for (const double u : {0.0, r.width_px - 1.0})
+    for (const double v : {0.0, r.height_px - 1.0}) {
       const cv::Vec3d q = M * cv::Vec3d(u, v, 1);
-      most = std::max(most, std::hypot(q[0] / q[2] - u, q[1] / q[2] - v));
+      if (std::hypot(q[0] / q[2] - u, q[1] / q[2] - v) >= 0.01) return false;
     }
-  return most;
+  return true;
 }
 
 // `view` turned to orientation `rolled` (about its optical centre) and given
@@ -106,8 +103,7 @@ FixationFrame ToFixationFrame(const rig::StereoFrame& frame) {
       IntoPlane(right, normal.normalized(), &f.right_roll_rad, &f.right_turn_rad);
   const double angle =
       std::max(RotationAngle(tl.transpose() * left), RotationAngle(tr.transpose() * right));
-  const rig::CameraIntrinsics& common = frame.left.intrinsics;
-  if (MovesNoPixel(common, angle) && IntrinsicsShiftPx(frame.right.intrinsics, common) < 0.01) {
+  if (MovesNoPixel(frame, angle)) {
     FixationFrame same = OriginalFrame(frame);
     same.left_roll_rad = f.left_roll_rad;
     same.right_roll_rad = f.right_roll_rad;
@@ -117,8 +113,8 @@ FixationFrame ToFixationFrame(const rig::StereoFrame& frame) {
   f.resampled = true;
   f.views.state = frame.state;
   f.views.timestamp_s = frame.timestamp_s;
-  f.views.left = TurnView(frame.left, tl, common, &f.left_H);
-  f.views.right = TurnView(frame.right, tr, common, &f.right_H);
+  f.views.left = TurnView(frame.left, tl, frame.left.intrinsics, &f.left_H);
+  f.views.right = TurnView(frame.right, tr, frame.left.intrinsics, &f.right_H);
   // Valid where every source pixel of the bilinear sample lies inside.
   const cv::Mat ones(frame.left.gray.size(), CV_8U, cv::Scalar(255));
   cv::warpPerspective(ones, f.left_valid, f.left_H, ones.size(), cv::INTER_LINEAR,
@@ -142,15 +138,13 @@ rig::StereoFrame ToParallelFrame(const rig::StereoFrame& frame) {
   rect.col(1) = rect.col(2).cross(rect.col(0));
   const double angle =
       std::max(RotationAngle(rect.transpose() * left), RotationAngle(rect.transpose() * right));
-  const rig::CameraIntrinsics& common = frame.left.intrinsics;
-  if (MovesNoPixel(common, angle) && IntrinsicsShiftPx(frame.right.intrinsics, common) < 0.01)
-    return frame;
+  if (MovesNoPixel(frame, angle)) return frame;
   rig::StereoFrame out;
   out.state = frame.state;
   out.timestamp_s = frame.timestamp_s;
   cv::Matx33d H;
-  out.left = TurnView(frame.left, rect, common, &H, cv::BORDER_REPLICATE);
-  out.right = TurnView(frame.right, rect, common, &H, cv::BORDER_REPLICATE);
+  out.left = TurnView(frame.left, rect, frame.left.intrinsics, &H, cv::BORDER_REPLICATE);
+  out.right = TurnView(frame.right, rect, frame.left.intrinsics, &H, cv::BORDER_REPLICATE);
   return out;
 }
 
