@@ -3,6 +3,8 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
+#include "rig/undistort.h"
+
 namespace {
 rig::RigGeometry Geometry() {
   rig::RigGeometry g;
@@ -75,6 +77,59 @@ TEST_CASE("encoder zeros and the mount turn the camera; the tilt zero folds into
   }
   // Mount angles survive the round trip through the rotation.
   CHECK((rig::MountRpyFromRotation(head.MountRotation()) - head.mount_rpy_rad).norm() < 1e-12);
+}
+
+TEST_CASE("a delivered pair: one K, no distortion, cameras turned to their heads", "[rig]") {
+  rig::RigCalibration c;
+  c.left = rig::CameraIntrinsics::FromHorizontalFov(640, 480, 0.5);
+  c.right = c.left;
+  c.right.fx_px *= 1.001;
+  c.right.cx_px += 0.8;
+  c.left.distortion = {-0.2, 0.05, 0.0002, -0.0001, 0};
+  c.right.distortion = {-0.18, 0.03, 0, 0, 0};
+  c.left_head.optical_centre_H = c.right_head.optical_centre_H = {0.02, 0.08, 0.02};
+  c.left_head.mount_rpy_rad = {0.026, 0.026, 0.026};
+  c.right_head.mount_rpy_rad = {-0.026, 0.026, -0.026};
+  c.left_head.pan_zero_rad = 0.0017;
+  c.right_head.tilt_zero_rad = 0.0017;
+  const rig::DeliveredPair d(c);
+  CHECK(d.intrinsics.distortion.empty());
+  CHECK(d.intrinsics.fx_px == c.left.fx_px);
+  CHECK(d.intrinsics.cx_px == c.left.cx_px);
+  const rig::RigGeometry raw = c.Geometry();
+  for (const rig::Side side : {rig::Side::kLeft, rig::Side::kRight}) {
+    const int s = static_cast<int>(side);
+    CHECK(d.geometry[side].mount_rpy_rad.isZero(0));
+    CHECK(d.geometry[side].optical_centre_H == raw[side].optical_centre_H);
+    CHECK(d.geometry[side].pan_zero_rad == raw[side].pan_zero_rad);
+    CHECK(d.geometry[side].tilt_zero_rad == raw[side].tilt_zero_rad);
+    REQUIRE(d.undistort[s].Active());
+    // A delivered pixel samples the raw pixel that shows the same ray: the
+    // ray of the delivered camera, imaged by the raw one (its mount and lens).
+    const rig::CameraStage stage{0.1, -0.2, 0.15};
+    const Eigen::Isometry3d delivered = d.geometry.WorldFromCamera(side, stage);
+    const Eigen::Isometry3d camera = raw.WorldFromCamera(side, stage);
+    CHECK((delivered.translation() - camera.translation()).norm() < 1e-12);
+    CHECK(Eigen::AngleAxisd(d.delivered_R_raw[s] * camera.linear().transpose() * delivered.linear())
+              .angle() < 1e-12);
+    double worst = 0;
+    for (const int u : {40, 320, 600})
+      for (const int v : {30, 240, 450}) {
+        const Eigen::Vector3d p_W = delivered * (0.9 * d.intrinsics.Ray(Eigen::Vector2d(u, v)));
+        const Eigen::Vector2d uv_raw = c.Intrinsics(side).Project(camera.inverse() * p_W);
+        const Eigen::Vector2d sampled(d.undistort[s].MapX().at<float>(v, u),
+                                      d.undistort[s].MapY().at<float>(v, u));
+        worst = std::max(worst, (uv_raw - sampled).norm());
+      }
+    INFO("side " << s << ": worst " << worst << " px");
+    CHECK(worst < 0.01);
+  }
+  // An ideal pair is delivered as it is captured.
+  rig::RigCalibration ideal;
+  ideal.left = ideal.right = rig::CameraIntrinsics::FromHorizontalFov(640, 480, 0.5);
+  const rig::DeliveredPair same(ideal);
+  CHECK_FALSE(same.undistort[0].Active());
+  CHECK_FALSE(same.undistort[1].Active());
 }
 
 TEST_CASE("FacingStage allows for the encoders' zeros", "[rig]") {

@@ -272,6 +272,23 @@ TEST_CASE("an imperfect rig images its truth and reports its belief; calibrated,
     calibrated.calibration = file;
     auto sim = scenes::LoadScene(path, calibrated);
     CHECK(sim->rig().Intrinsics(rig::Side::kLeft).distortion.empty());
+    // Delivered as cameras turned to their heads: at home (pan and tilt
+    // readings zero) the views differ only by the pan zeros' 0.2 degrees,
+    // and the true camera is the delivered one turned by its mount.
+    const rig::StereoFrame frame = sim->rig().Capture();
+    CHECK(Eigen::AngleAxisd(frame.left.world_T_camera.linear().transpose() *
+                            frame.right.world_T_camera.linear())
+                  .angle() /
+              kDeg ==
+          Approx(0.2).margin(1e-9));
+    for (rig::Side side : {rig::Side::kLeft, rig::Side::kRight}) {
+      const sim::SimRig::TrueCamera real = sim->sim_rig().True(side);
+      const Eigen::Matrix3d delivered =
+          real.world_T_camera.linear() * real.delivered_R_camera.transpose();
+      CHECK(Eigen::AngleAxisd(frame[side].world_T_camera.linear().transpose() * delivered).angle() /
+                kDeg <
+            1e-3);
+    }
     const double worst = WorstProjectionPx(sim.get(), points, 40);
     INFO("calibrated: worst " << worst << " px");
     CHECK(worst < 0.3);

@@ -14,7 +14,7 @@ mkdir -p "$out"
 out=$(cd "$out" && pwd)
 imperfect=$src/experiments/configs/imperfect-rig.yaml
 
-"$fovea" chessboards --head --config "$imperfect" --placements 4 --views 12 --square 0.02 \
+"$fovea" chessboards --head --config "$imperfect" --placements 8 --views 12 --square 0.02 \
   --out "$out/boards"
 "$fovea" calibrate-head --views "$out/boards/views.yaml" --board 9x6 --square 0.02 \
   --out "$out/calibration.yaml" --truth "$out/boards/truth.yaml"

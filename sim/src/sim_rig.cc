@@ -93,10 +93,54 @@ void PixelMaps(const std::vector<std::pair<rig::CameraIntrinsics, rig::CameraInt
     }
 }
 
+// For every delivered pixel of `undistort`'s camera, the pixel of the true
+// camera's ideal pinhole that shows the same ray: the raw pixel the remap
+// samples, through the true lens (`true_k` -> `ideal`). Empty maps when
+// that is the pixel itself.
+void DeliveredToTrue(const rig::Undistorter& undistort, const rig::CameraIntrinsics& true_k,
+                     const rig::CameraIntrinsics& ideal, cv::Mat* map_x, cv::Mat* map_y) {
+  if (!undistort.Active()) {
+    PixelMaps({{true_k, ideal}}, map_x, map_y);
+    return;
+  }
+  *map_x = undistort.MapX().clone();
+  *map_y = undistort.MapY().clone();
+  if (SameCamera(true_k, ideal)) return;
+  std::vector<cv::Point2f> pixels;
+  pixels.reserve(map_x->total());
+  for (int v = 0; v < map_x->rows; ++v)
+    for (int u = 0; u < map_x->cols; ++u)
+      pixels.emplace_back(map_x->at<float>(v, u), map_y->at<float>(v, u));
+  pixels = SameRays(pixels, true_k, ideal);
+  for (int v = 0, i = 0; v < map_x->rows; ++v)
+    for (int u = 0; u < map_x->cols; ++u, ++i) {
+      map_x->at<float>(v, u) = pixels[i].x;
+      map_y->at<float>(v, u) = pixels[i].y;
+    }
+}
+
+// What the rig believes it is: its calibration file, else its design.
+rig::RigCalibration Belief(const SimRigConfig& config) {
+  rig::RigCalibration belief;
+  if (!config.calibration.empty()) {
+    belief = rig::LoadCalibration(config.calibration);
+    rig::CheckCalibrationSize(belief, config.calibration, config.width_px, config.height_px);
+  } else {
+    belief.left = belief.right = rig::Undistorter::Pinhole(TrueIntrinsics(config));
+    belief.left_head.optical_centre_H = belief.right_head.optical_centre_H =
+        config.optical_centre_offset_m;
+  }
+  return belief;
+}
+
 }  // namespace
 
 SimRig::SimRig(World* world, const SimRigConfig& config)
-    : world_(world), config_(config), stage_rng_(SplitMix64(config.seed ^ 0x5eedULL)) {
+    : world_(world),
+      config_(config),
+      belief_(Belief(config)),
+      delivered_(belief_),
+      stage_rng_(SplitMix64(config.seed ^ 0x5eedULL)) {
   using rig::Axis;
   const double lin_steps = config.baseline_steps_per_mm * 1000.0;
   const double ang_steps = config.pan_tilt_steps_per_deg / kDegToRad;
@@ -105,21 +149,11 @@ SimRig::SimRig(World* world, const SimRigConfig& config)
   limits_[Axis::kRightBaseline] = {config.carriage_min_m, config.carriage_max_m, lin_steps};
   limits_[Axis::kLeftPan] = limits_[Axis::kRightPan] = {-pan, pan, ang_steps};
   limits_[Axis::kLeftTilt] = limits_[Axis::kRightTilt] = {-tilt, tilt, ang_steps};
-  // The belief: a calibration file, else the design.
-  const rig::CameraIntrinsics true_k = TrueIntrinsics(config);
-  const rig::CameraIntrinsics ideal = rig::Undistorter::Pinhole(true_k);
-  rig::RigCalibration belief;
-  if (!config.calibration.empty()) {
-    belief = rig::LoadCalibration(config.calibration);
-    rig::CheckCalibrationSize(belief, config.calibration, config.width_px, config.height_px);
-  } else {
-    belief.left = belief.right = ideal;
-    belief.left_head.optical_centre_H = belief.right_head.optical_centre_H =
-        config.optical_centre_offset_m;
-  }
-  geometry_ = belief.Geometry();
+  raw_geometry_ = belief_.Geometry();
 
   // The truth's lens and sensor, and how delivered pixels relate to it.
+  const rig::CameraIntrinsics true_k = TrueIntrinsics(config);
+  const rig::CameraIntrinsics ideal = rig::Undistorter::Pinhole(true_k);
   render_size_ = RenderSize(config);
   if (!true_k.distortion.empty()) {
     rig::CameraIntrinsics wide = ideal;
@@ -132,12 +166,9 @@ SimRig::SimRig(World* world, const SimRigConfig& config)
   const Imperfections& im = config.imperfections;
   for (rig::Side side : {rig::Side::kLeft, rig::Side::kRight}) {
     const int s = static_cast<int>(side);
-    believed_[s] = belief.Intrinsics(side);
-    undistort_[s] = rig::Undistorter(believed_[s]);
-    // Delivered pixel -> raw pixel (through the believed lens) -> ideal
+    // Delivered pixel -> raw pixel (the believed lens and mount) -> ideal
     // pinhole pixel (the ray the true lens images there).
-    PixelMaps({{rig::Undistorter::Pinhole(believed_[s]), believed_[s]}, {true_k, ideal}},
-              &delivered_x_[s], &delivered_y_[s]);
+    DeliveredToTrue(delivered_.undistort[s], true_k, ideal, &delivered_x_[s], &delivered_y_[s]);
     if (im[side].gain != 1 || im.vignetting != 0) {
       gain_[s].create(config.height_px, config.width_px, CV_32FC1);
       const double r2_max = ideal.cx_px * ideal.cx_px + ideal.cy_px * ideal.cy_px;
@@ -224,8 +255,8 @@ rig::StageState SimRig::State() const {
   return rig::StageState::FromArray(q);
 }
 
-rig::CameraIntrinsics SimRig::Intrinsics(rig::Side side) const {
-  return rig::Undistorter::Pinhole(believed_[static_cast<int>(side)]);  // Capture undistorts
+rig::CameraIntrinsics SimRig::Intrinsics(rig::Side) const {
+  return delivered_.intrinsics;  // what Capture delivers
 }
 
 SimRig::TrueCamera SimRig::True(rig::Side side) const {
@@ -235,6 +266,7 @@ SimRig::TrueCamera SimRig::True(rig::Side side) const {
   t.ideal = rig::Undistorter::Pinhole(TrueIntrinsics(config_));
   t.map_x = delivered_x_[s];
   t.map_y = delivered_y_[s];
+  t.delivered_R_camera = delivered_.delivered_R_raw[s];
   return t;
 }
 
@@ -283,12 +315,13 @@ rig::StereoFrame SimRig::Capture(const rig::CaptureOptions& options) {
     }
     const cv::Mat raw = view.gray;  // what a recording keeps: a hardware rig undistorts it
     if (!options.raw) {
-      view.gray = undistort_[s].Apply(view.gray);
-      if (options.color) view.bgr = undistort_[s].Apply(view.bgr);
+      view.gray = delivered_.undistort[s].Apply(view.gray);
+      if (options.color) view.bgr = delivered_.undistort[s].Apply(view.bgr);
     }
-    view.intrinsics = options.raw ? believed_[s] : Intrinsics(side);
+    view.intrinsics = options.raw ? belief_.Intrinsics(side) : Intrinsics(side);
     // Where the rig believes its camera is: its kinematics at the readings.
-    view.world_T_camera = geometry_.WorldFromCamera(side, frame.state[side]);
+    view.world_T_camera = (options.raw ? raw_geometry_ : delivered_.geometry)
+                              .WorldFromCamera(side, frame.state[side]);
     if (!config_.record_dir.empty()) {
       // Numbered from 0 in capture order: OpenCV's image-sequence reader
       // (and a HardwareRig camera) replays them.

@@ -81,15 +81,15 @@ cv::Mat CameraSource::Grab() {
   return gray;
 }
 
-HardwareRig::HardwareRig(HardwareRigConfig config) : calibration_(config.calibration) {
+HardwareRig::HardwareRig(HardwareRigConfig config)
+    : calibration_(config.calibration),
+      delivered_(calibration_),
+      raw_geometry_(calibration_.Geometry()) {
   for (int i = 0; i < kNumAxes; ++i) {
     const IndexerAxis& a = config.stages.axes[i];
     limits_.axes[i] = {a.min, a.max, a.steps_per_unit};
   }
-  geometry_ = calibration_.Geometry();
   home_ = limits_.Quantize(StageState::Parallel(config.home_baseline_m));
-  undistort_[0] = Undistorter(calibration_.left);
-  undistort_[1] = Undistorter(calibration_.right);
   left_ = std::make_unique<CameraSource>(config.left_camera, calibration_.left.width_px,
                                          calibration_.left.height_px, config.frame_timeout);
   right_ = std::make_unique<CameraSource>(config.right_camera, calibration_.right.width_px,
@@ -108,8 +108,8 @@ MoveResult HardwareRig::MoveTo(const StageState& target) {
 
 StageState HardwareRig::State() const { return state_; }
 
-CameraIntrinsics HardwareRig::Intrinsics(Side side) const {
-  return Undistorter::Pinhole(calibration_.Intrinsics(side));  // Capture undistorts
+CameraIntrinsics HardwareRig::Intrinsics(Side) const {
+  return delivered_.intrinsics;  // what Capture delivers
 }
 
 StereoFrame HardwareRig::Capture(const CaptureOptions& options) {
@@ -120,11 +120,11 @@ StereoFrame HardwareRig::Capture(const CaptureOptions& options) {
   for (const Side side : {Side::kLeft, Side::kRight}) {
     CameraView& view = side == Side::kLeft ? frame.left : frame.right;
     const cv::Mat raw = (side == Side::kLeft ? left_ : right_)->Grab();
-    // Frames go out undistorted, with the same pinhole intrinsics, unless
-    // asked for raw.
-    view.gray = options.raw ? raw : undistort_[static_cast<int>(side)].Apply(raw);
+    // Frames go out as DeliveredPair describes, unless asked for raw.
+    view.gray = options.raw ? raw : delivered_.undistort[static_cast<int>(side)].Apply(raw);
     view.intrinsics = options.raw ? calibration_.Intrinsics(side) : Intrinsics(side);
-    view.world_T_camera = geometry_.WorldFromCamera(side, state_[side]);
+    view.world_T_camera =
+        (options.raw ? raw_geometry_ : delivered_.geometry).WorldFromCamera(side, state_[side]);
   }
   return frame;
 }

@@ -32,7 +32,7 @@ class SimRig : public rig::Rig {
   rig::StageState State() const override;
   rig::StereoFrame Capture(const rig::CaptureOptions& options = {}) override;
   const rig::RigLimits& Limits() const override { return limits_; }
-  const rig::RigGeometry& Geometry() const override { return geometry_; }
+  const rig::RigGeometry& Geometry() const override { return delivered_.geometry; }
   rig::CameraIntrinsics Intrinsics(rig::Side side) const override;
   rig::StageState Home() const override { return home_; }
 
@@ -44,10 +44,15 @@ class SimRig : public rig::Rig {
   /// configuration's), and for every delivered pixel the pixel of that ideal
   /// camera that shows the same ray (CV_32FC1 maps; empty when the two are
   /// the same pixel, as on a rig without distortion that believes its true K).
+  /// The delivered image is that of a camera at the same optical centre,
+  /// turned by `delivered_R_camera` (the rig's believed mount, taken off on
+  /// capture): a point p in this camera's frame is delivered_R_camera * p in
+  /// the delivered camera's.
   struct TrueCamera {
     Eigen::Isometry3d world_T_camera = Eigen::Isometry3d::Identity();
     rig::CameraIntrinsics ideal;
     cv::Mat map_x, map_y;
+    Eigen::Matrix3d delivered_R_camera = Eigen::Matrix3d::Identity();
   };
   TrueCamera True(rig::Side side) const;
 
@@ -55,10 +60,10 @@ class SimRig : public rig::Rig {
   World* world_;
   SimRigConfig config_;
   rig::RigLimits limits_;
-  rig::RigGeometry geometry_;                      ///< believed
-  std::array<rig::CameraIntrinsics, 2> believed_;  ///< with the believed distortion
-  std::array<rig::Undistorter, 2> undistort_;      ///< the believed distortion removed
-  cv::Size render_size_;                           ///< RenderSize(config)
+  rig::RigCalibration belief_;     ///< what it believes it is: raw cameras and heads
+  rig::DeliveredPair delivered_;   ///< what Capture delivers, from the belief
+  rig::RigGeometry raw_geometry_;  ///< the belief's, for raw captures
+  cv::Size render_size_;           ///< RenderSize(config)
   cv::Mat distort_x_, distort_y_;  ///< render -> distorted image; empty for ideal lenses
   std::array<cv::Mat, 2> gain_;    ///< per pixel: gain x vignetting; empty when ideal
   std::array<cv::Mat, 2> delivered_x_, delivered_y_;  ///< see TrueCamera

@@ -54,17 +54,17 @@ class HardwareRig : public Rig {
   StageState State() const override;
   StereoFrame Capture(const CaptureOptions& options = {}) override;
   const RigLimits& Limits() const override { return limits_; }
-  const RigGeometry& Geometry() const override { return geometry_; }
+  const RigGeometry& Geometry() const override { return delivered_.geometry; }
   CameraIntrinsics Intrinsics(Side side) const override;
   StageState Home() const override { return home_; }
 
  private:
   RigCalibration calibration_;
+  DeliveredPair delivered_;   // what Capture delivers, from the calibration
+  RigGeometry raw_geometry_;  // the calibration's, for raw captures
   std::unique_ptr<IndexerDriver> driver_;
   std::unique_ptr<CameraSource> left_, right_;
-  Undistorter undistort_[2];  // per side, from the calibration
   RigLimits limits_;
-  RigGeometry geometry_;
   StageState home_;
   mutable StageState state_;
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
