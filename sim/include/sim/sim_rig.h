@@ -39,15 +39,15 @@ class SimRig : public rig::Rig {
   /// Simulated time since load, seconds.
   double TimeS() const;
 
-  /// What a delivered (undistorted) image of one camera really shows: the
-  /// camera's true pose now, its ideal pinhole intrinsics (the
+  /// What a delivered image of one camera (rig::DeliveredPair) really
+  /// shows: the camera's true pose now, its ideal pinhole intrinsics (the
   /// configuration's), and for every delivered pixel the pixel of that ideal
   /// camera that shows the same ray (CV_32FC1 maps; empty when the two are
-  /// the same pixel, as on a rig without distortion that believes its true K).
-  /// The delivered image is that of a camera at the same optical centre,
-  /// turned by `delivered_R_camera` (the rig's believed mount, taken off on
-  /// capture): a point p in this camera's frame is delivered_R_camera * p in
-  /// the delivered camera's.
+  /// the same pixel, as on a rig without distortion that believes its true K
+  /// and no mount). The delivered image is that of a camera at the same
+  /// optical centre turned by `delivered_R_camera` (the believed mount,
+  /// taken off on capture): a point p in the true camera's frame is
+  /// delivered_R_camera * p in the delivered camera's.
   struct TrueCamera {
     Eigen::Isometry3d world_T_camera = Eigen::Isometry3d::Identity();
     rig::CameraIntrinsics ideal;
