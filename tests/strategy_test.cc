@@ -234,3 +234,40 @@ TEST_CASE("selection.strategy names the strategy; deterministic keeps its meanin
   o.deterministic = false;
   CHECK_THROWS_WITH(o.Check(), Catch::Contains("selection.strategy"));
 }
+
+TEST_CASE("the paper's rule chooses again in one context as if from scratch", "[fovea][strategy]") {
+  // A textured image, so that every criterion has something to weigh.
+  cv::Mat image(kHeight, kWidth, CV_8U);
+  cv::randu(image, 0, 255);
+  cv::GaussianBlur(image, image, cv::Size(0, 0), 1.5);
+  const fovea::PatchMap map = PlaneWithHoles({cv::Rect(20, 40, 30, 30)});
+  const fovea::SelectionContext c = fovea::SelectionContext::Make(image, View(), map, true);
+  const std::unique_ptr<fovea::FixationStrategy> rule =
+      fovea::MakeStrategy(Options(), fovea::CriteriaOptions{});
+  // The first three choices are passed over: the weights kept between the
+  // tries must give what weighing afresh each time (the default) gives.
+  int calls = 0;
+  auto pass_three = [&calls](const fovea::SelectionSummary&) { return ++calls > 3; };
+  std::vector<Eigen::Vector3d> kept, fresh;
+  std::mt19937_64 a(7), b(7);
+  const fovea::SelectionSummary s = rule->ChooseAccepted(c, map, &kept, &a, pass_three, 8);
+  calls = 0;
+  const fovea::SelectionSummary t =
+      rule->FixationStrategy::ChooseAccepted(c, map, &fresh, &b, pass_three, 8);
+  REQUIRE(s.ok);
+  CHECK(s.prescreened == 3);
+  CHECK(t.prescreened == 3);
+  CHECK(s.pixel == t.pixel);
+  CHECK(s.composite_chosen == t.composite_chosen);
+  REQUIRE(kept.size() == 3);
+  CHECK(kept == fresh);
+  // Each choice passed over is refused with its neighbourhood: no two alike.
+  CHECK(kept[0] != kept[1]);
+  CHECK(kept[1] != kept[2]);
+  // At most max_passed are passed over.
+  std::vector<Eigen::Vector3d> none;
+  const fovea::SelectionSummary u = rule->ChooseAccepted(
+      c, map, &none, &a, [](const fovea::SelectionSummary&) { return false; }, 2);
+  CHECK(u.prescreened == 2);
+  CHECK(none.size() == 2);
+}

@@ -98,14 +98,13 @@ SelectionSummary ChooseTarget(const FoveaRun& run, LoopState& state, FixationStr
   context.visits = state.visits;
   if (options.stay_in_idr_view && !in_reference) context.region = run.idr.final_frame.left;
   constexpr int kMaxPrescreened = 8;
-  for (int i = 0;; ++i) {
-    SelectionSummary s = strategy.Choose(context, run.map, state.refused, rng);
-    s.prescreened = i;
-    if (!s.ok || !s.in_hole || !options.prescreen_holes || i == kMaxPrescreened ||
-        UniqueAlongRay(frame, s.pixel, hole_depths, options.fixation.servo))
-      return s;
-    state.refused.push_back(s.point_W);
-  }
+  return strategy.ChooseAccepted(
+      context, run.map, &state.refused, rng,
+      [&](const SelectionSummary& s) {
+        return !s.in_hole || !options.prescreen_holes ||
+               UniqueAlongRay(frame, s.pixel, hole_depths, options.fixation.servo);
+      },
+      kMaxPrescreened);
 }
 
 // Total travel of each kind of axis between two stage states, both cameras

@@ -258,19 +258,33 @@ void CapNear(const SelectionContext& c, const std::vector<Eigen::Vector3d>& poin
     });
 }
 
+FixationSelector::Weights FixationSelector::Weigh(const SelectionContext& c) const {
+  Weights w;
+  w.product = cv::Mat(c.image.size(), CV_64F, cv::Scalar(1.0));
+  for (const auto& criterion : criteria_) {
+    w.each.push_back(criterion->Evaluate(c));
+    w.product = w.product.mul(w.each.back());
+  }
+  w.candidates = Candidates(c, {}, options_);
+  return w;
+}
+
 cv::Mat FixationSelector::Composite(const SelectionContext& c,
                                     const std::vector<Eigen::Vector3d>& refused_W,
                                     std::vector<cv::Mat>* each) const {
-  cv::Mat composite(c.image.size(), CV_64F, cv::Scalar(1.0));
-  if (each) each->clear();
-  for (const auto& criterion : criteria_) {
-    const cv::Mat w = criterion->Evaluate(c);
-    composite = composite.mul(w);
-    if (each) each->push_back(w);
-  }
+  const Weights w = Weigh(c);
+  if (each) *each = w.each;
+  return Composite(c, w, refused_W);
+}
+
+cv::Mat FixationSelector::Composite(const SelectionContext& c, const Weights& w,
+                                    const std::vector<Eigen::Vector3d>& refused_W) const {
   // Only the candidates: pixels the map can raytrace, away from the border
   // and from refused points.
-  composite.setTo(0.0, Candidates(c, refused_W, options_) == 0);
+  cv::Mat candidates = w.candidates.clone();
+  ClearNear(c, refused_W, options_.refused_radius_m, &candidates);
+  cv::Mat composite = w.product.clone();
+  composite.setTo(0.0, candidates == 0);
   NormalizeSum(&composite);
   return composite;
 }
@@ -283,9 +297,16 @@ double DrawExponential(double r, double s) {
 SelectionSummary FixationSelector::Choose(const SelectionContext& c, const PatchMap& map,
                                           const std::vector<Eigen::Vector3d>& refused_W,
                                           std::mt19937_64* rng) const {
+  return Choose(c, Weigh(c), map, refused_W, rng);
+}
+
+SelectionSummary FixationSelector::Choose(const SelectionContext& c, const Weights& weights,
+                                          const PatchMap& map,
+                                          const std::vector<Eigen::Vector3d>& refused_W,
+                                          std::mt19937_64* rng) const {
   SelectionSummary s;
-  std::vector<cv::Mat> each;
-  const cv::Mat composite = Composite(c, refused_W, &each);
+  const std::vector<cv::Mat>& each = weights.each;
+  const cv::Mat composite = Composite(c, weights, refused_W);
   double c_max = 0;
   cv::minMaxLoc(composite, nullptr, &c_max);
   s.composite_max = c_max;

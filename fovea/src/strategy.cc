@@ -21,6 +21,19 @@ class CompositeStrategy : public FixationStrategy {
                           std::mt19937_64* rng) override {
     return selector_.Choose(context, map, refused_W, rng);
   }
+  SelectionSummary ChooseAccepted(const SelectionContext& context, const PatchMap& map,
+                                  std::vector<Eigen::Vector3d>* refused_W, std::mt19937_64* rng,
+                                  const std::function<bool(const SelectionSummary&)>& accept,
+                                  int max_passed) override {
+    // The criteria and candidates once: a retry differs in its refused
+    // points only.
+    const FixationSelector::Weights weights = selector_.Weigh(context);
+    return ChooseUntil(
+        [&](const std::vector<Eigen::Vector3d>& refused) {
+          return selector_.Choose(context, weights, map, refused, rng);
+        },
+        refused_W, accept, max_passed);
+  }
 
  private:
   std::string name_;
@@ -28,6 +41,29 @@ class CompositeStrategy : public FixationStrategy {
 };
 
 }  // namespace
+
+SelectionSummary FixationStrategy::ChooseAccepted(
+    const SelectionContext& context, const PatchMap& map, std::vector<Eigen::Vector3d>* refused_W,
+    std::mt19937_64* rng, const std::function<bool(const SelectionSummary&)>& accept,
+    int max_passed) {
+  return ChooseUntil(
+      [&](const std::vector<Eigen::Vector3d>& refused) {
+        return Choose(context, map, refused, rng);
+      },
+      refused_W, accept, max_passed);
+}
+
+SelectionSummary FixationStrategy::ChooseUntil(
+    const std::function<SelectionSummary(const std::vector<Eigen::Vector3d>&)>& choose,
+    std::vector<Eigen::Vector3d>* refused_W,
+    const std::function<bool(const SelectionSummary&)>& accept, int max_passed) {
+  for (int i = 0;; ++i) {
+    SelectionSummary s = choose(*refused_W);
+    s.prescreened = i;
+    if (!s.ok || i == max_passed || accept(s)) return s;
+    refused_W->push_back(s.point_W);
+  }
+}
 
 std::unique_ptr<FixationStrategy> MakeStrategy(const SelectionOptions& selection,
                                                const CriteriaOptions& criteria) {

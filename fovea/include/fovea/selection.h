@@ -237,14 +237,32 @@ class FixationSelector {
   FixationSelector(std::vector<std::shared_ptr<const FixationCriterion>> criteria,
                    const SelectionOptions& options);
 
+  /// What a choice computes from its context alone: choosing again in the
+  /// same context with more refused points (the loop's prescreen of holes)
+  /// reuses it, and only the refused points' neighbourhoods are cleared
+  /// anew.
+  struct Weights {
+    std::vector<cv::Mat> each;  ///< each criterion's weights (CV_64F)
+    cv::Mat product;            ///< their product, in the criteria's order
+    cv::Mat candidates;         ///< Candidates with no refused point
+  };
+  Weights Weigh(const SelectionContext& context) const;
+
   /// Product of the criteria, normalized, zero where the map has no point,
   /// near the border or near a refused point.
   cv::Mat Composite(const SelectionContext& context, const std::vector<Eigen::Vector3d>& refused_W,
                     std::vector<cv::Mat>* each = nullptr) const;
+  /// The same from the context's weights.
+  cv::Mat Composite(const SelectionContext& context, const Weights& weights,
+                    const std::vector<Eigen::Vector3d>& refused_W) const;
 
   /// Draws the next fixation point.
   SelectionSummary Choose(const SelectionContext& context, const PatchMap& map,
                           const std::vector<Eigen::Vector3d>& refused_W,
+                          std::mt19937_64* rng) const;
+  /// The same from the context's weights (Weigh(context)).
+  SelectionSummary Choose(const SelectionContext& context, const Weights& weights,
+                          const PatchMap& map, const std::vector<Eigen::Vector3d>& refused_W,
                           std::mt19937_64* rng) const;
 
   const std::vector<std::shared_ptr<const FixationCriterion>>& criteria() const {

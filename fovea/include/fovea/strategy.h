@@ -7,6 +7,7 @@
 // thing from one fixation to the next.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <random>
 #include <string>
@@ -31,6 +32,23 @@ class FixationStrategy {
   virtual SelectionSummary Choose(const SelectionContext& context, const PatchMap& map,
                                   const std::vector<Eigen::Vector3d>& refused_W,
                                   std::mt19937_64* rng) = 0;
+  /// Chooses in `context` until `accept` takes the choice, adding each
+  /// choice it passes over to `refused_W` (its neighbourhood goes with it),
+  /// at most `max_passed` times; a choice that is not ok ends the search.
+  /// The choice returned has `prescreened` set to the number passed over.
+  /// A strategy may keep what it computed from the context alone between
+  /// the tries (the default calls Choose each time).
+  virtual SelectionSummary ChooseAccepted(
+      const SelectionContext& context, const PatchMap& map, std::vector<Eigen::Vector3d>* refused_W,
+      std::mt19937_64* rng, const std::function<bool(const SelectionSummary&)>& accept,
+      int max_passed);
+
+ protected:
+  /// ChooseAccepted's loop around `choose` (a choice given the refused points).
+  static SelectionSummary ChooseUntil(
+      const std::function<SelectionSummary(const std::vector<Eigen::Vector3d>&)>& choose,
+      std::vector<Eigen::Vector3d>* refused_W,
+      const std::function<bool(const SelectionSummary&)>& accept, int max_passed);
 };
 
 /// The strategy `selection.Strategy()` names, with its settings. `options`
