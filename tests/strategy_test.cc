@@ -250,10 +250,10 @@ TEST_CASE("the paper's rule chooses again in one context as if from scratch", "[
   auto pass_three = [&calls](const fovea::SelectionSummary&) { return ++calls > 3; };
   std::vector<Eigen::Vector3d> kept, fresh;
   std::mt19937_64 a(7), b(7);
-  const fovea::SelectionSummary s = rule->ChooseAccepted(c, map, &kept, &a, pass_three, 8);
+  const fovea::SelectionSummary s = rule->ChooseAccepted(c, map, &kept, &a, pass_three, 8, false);
   calls = 0;
   const fovea::SelectionSummary t =
-      rule->FixationStrategy::ChooseAccepted(c, map, &fresh, &b, pass_three, 8);
+      rule->FixationStrategy::ChooseAccepted(c, map, &fresh, &b, pass_three, 8, false);
   REQUIRE(s.ok);
   CHECK(s.prescreened == 3);
   CHECK(t.prescreened == 3);
@@ -264,10 +264,20 @@ TEST_CASE("the paper's rule chooses again in one context as if from scratch", "[
   // Each choice passed over is refused with its neighbourhood: no two alike.
   CHECK(kept[0] != kept[1]);
   CHECK(kept[1] != kept[2]);
+  // The next call in the same context (the loop's attempt was refused)
+  // keeps the weights too: the same choice as afresh.
+  kept.push_back(s.point_W);
+  fresh.push_back(t.point_W);
+  auto take = [](const fovea::SelectionSummary&) { return true; };
+  const fovea::SelectionSummary s2 = rule->ChooseAccepted(c, map, &kept, &a, take, 8, true);
+  const fovea::SelectionSummary t2 =
+      rule->FixationStrategy::ChooseAccepted(c, map, &fresh, &b, take, 8, true);
+  CHECK(s2.pixel == t2.pixel);
+  CHECK(s2.pixel != s.pixel);
   // At most max_passed are passed over.
   std::vector<Eigen::Vector3d> none;
   const fovea::SelectionSummary u = rule->ChooseAccepted(
-      c, map, &none, &a, [](const fovea::SelectionSummary&) { return false; }, 2);
+      c, map, &none, &a, [](const fovea::SelectionSummary&) { return false; }, 2, false);
   CHECK(u.prescreened == 2);
   CHECK(none.size() == 2);
 }

@@ -1,6 +1,7 @@
 #include "fovea/ddr.h"
 
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 
 #include "fovea/geometry.h"
@@ -67,6 +68,10 @@ struct LoopState {
   bool has_fixation = false;
   Tessellation current;  ///< the current fixation's
   std::vector<Eigen::Vector3d> refused;
+  /// The last attempt was refused: the next one chooses in the same view
+  /// and map (only the refused points grew).
+  bool last_refused = false;
+  std::optional<SelectionContext> context;  ///< the last choice's
   std::vector<SelectionContext::Visit> visits;
   std::vector<double> share_history;
 };
@@ -88,23 +93,29 @@ SelectionSummary ChooseTarget(const FoveaRun& run, LoopState& state, FixationStr
   }
   const bool in_reference = strategy.View() == StrategyView::kReference;
   const rig::StereoFrame& frame = in_reference ? run.idr.final_frame : state.frame;
-  const rig::CameraView& view = frame.left;
-  SelectionContext context = SelectionContext::Make(view.gray, view, run.map, options.fixate_holes);
-  context.eye_W = state.frame.left.world_T_camera;
-  context.has_fixation = state.has_fixation;
-  context.fixation_depth_m = state.current.fixation_depth_m;
-  context.z_t_near_m = state.current.z_t_near_m;
-  context.z_t_far_m = state.current.z_t_far_m;
-  context.visits = state.visits;
-  if (options.stay_in_idr_view && !in_reference) context.region = run.idr.final_frame.left;
+  // After a refused attempt the view, the map and the visits are as they
+  // were: the context stays, and only the refused points grew.
+  const bool same_context = state.last_refused && state.context.has_value();
+  if (!same_context) {
+    const rig::CameraView& view = frame.left;
+    SelectionContext& context = state.context.emplace(
+        SelectionContext::Make(view.gray, view, run.map, options.fixate_holes));
+    context.eye_W = state.frame.left.world_T_camera;
+    context.has_fixation = state.has_fixation;
+    context.fixation_depth_m = state.current.fixation_depth_m;
+    context.z_t_near_m = state.current.z_t_near_m;
+    context.z_t_far_m = state.current.z_t_far_m;
+    context.visits = state.visits;
+    if (options.stay_in_idr_view && !in_reference) context.region = run.idr.final_frame.left;
+  }
   constexpr int kMaxPrescreened = 8;
   return strategy.ChooseAccepted(
-      context, run.map, &state.refused, rng,
+      *state.context, run.map, &state.refused, rng,
       [&](const SelectionSummary& s) {
         return !s.in_hole || !options.prescreen_holes ||
                UniqueAlongRay(frame, s.pixel, hole_depths, options.fixation.servo);
       },
-      kMaxPrescreened);
+      kMaxPrescreened, same_context);
 }
 
 // Total travel of each kind of axis between two stage states, both cameras
@@ -236,6 +247,7 @@ FoveaRun RunFovea(rig::Rig& rig, const StereoMatcher& matcher, const FoveaOption
     rec.time.servo_s = r.servo_wall_s;
     rec.motion_time_s = r.motion_time_s;
     run.motion_time_s += r.motion_time_s;
+    state.last_refused = !r.ok;
     if (!r.ok) {
       rec.why = r.why;
       state.refused.push_back(rec.target_W);

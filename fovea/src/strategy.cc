@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 
 namespace fovea {
 namespace {
@@ -24,13 +25,13 @@ class CompositeStrategy : public FixationStrategy {
   SelectionSummary ChooseAccepted(const SelectionContext& context, const PatchMap& map,
                                   std::vector<Eigen::Vector3d>* refused_W, std::mt19937_64* rng,
                                   const std::function<bool(const SelectionSummary&)>& accept,
-                                  int max_passed) override {
-    // The criteria and candidates once: a retry differs in its refused
-    // points only.
-    const FixationSelector::Weights weights = selector_.Weigh(context);
+                                  int max_passed, bool same_context) override {
+    // The criteria and candidates once per context: a retry differs in its
+    // refused points only.
+    if (!same_context || !weights_) weights_ = selector_.Weigh(context);
     return ChooseUntil(
         [&](const std::vector<Eigen::Vector3d>& refused) {
-          return selector_.Choose(context, weights, map, refused, rng);
+          return selector_.Choose(context, *weights_, map, refused, rng);
         },
         refused_W, accept, max_passed);
   }
@@ -38,6 +39,7 @@ class CompositeStrategy : public FixationStrategy {
  private:
   std::string name_;
   FixationSelector selector_;
+  std::optional<FixationSelector::Weights> weights_;  ///< of the last context
 };
 
 }  // namespace
@@ -45,7 +47,7 @@ class CompositeStrategy : public FixationStrategy {
 SelectionSummary FixationStrategy::ChooseAccepted(
     const SelectionContext& context, const PatchMap& map, std::vector<Eigen::Vector3d>* refused_W,
     std::mt19937_64* rng, const std::function<bool(const SelectionSummary&)>& accept,
-    int max_passed) {
+    int max_passed, bool /*same_context*/) {
   return ChooseUntil(
       [&](const std::vector<Eigen::Vector3d>& refused) {
         return Choose(context, map, refused, rng);

@@ -37,11 +37,13 @@ class FixationStrategy {
   /// at most `max_passed` times; a choice that is not ok ends the search.
   /// The choice returned has `prescreened` set to the number passed over.
   /// A strategy may keep what it computed from the context alone between
-  /// the tries (the default calls Choose each time).
+  /// the tries (the default calls Choose each time), and into the next call
+  /// when `same_context` says that its context is this call's, unchanged
+  /// (the loop's attempt was refused: the view and the map stay).
   virtual SelectionSummary ChooseAccepted(
       const SelectionContext& context, const PatchMap& map, std::vector<Eigen::Vector3d>* refused_W,
       std::mt19937_64* rng, const std::function<bool(const SelectionSummary&)>& accept,
-      int max_passed);
+      int max_passed, bool same_context);
 
  protected:
   /// ChooseAccepted's loop around `choose` (a choice given the refused points).
