@@ -105,12 +105,8 @@ cv::Mat DeliveredDepth(const cv::Mat& true_z, const sim::SimRig::TrueCamera& tru
     for (int x = 0; x < out.cols; ++x) {
       float& z = out.at<float>(y, x);
       if (z <= 0) continue;
-      const Eigen::Vector2d ideal = true_camera.map_x.empty()
-                                        ? Eigen::Vector2d(x, y)
-                                        : Eigen::Vector2d(true_camera.map_x.at<float>(y, x),
-                                                          true_camera.map_y.at<float>(y, x));
-      z = static_cast<float>(
-          true_camera.delivered_R_camera.row(2).dot(z * true_camera.ideal.Ray(ideal)));
+      z = static_cast<float>(true_camera.delivered_R_camera.row(2).dot(
+          z * true_camera.ideal.Ray(true_camera.IdealPixel(x, y))));
     }
   return out;
 }
@@ -186,11 +182,8 @@ ReferenceView MakeReferenceView(rig::Rig& rig, sim::Simulation& sim) {
     for (int x = 0; x < ref.textured.cols; ++x) {
       const float z = ref.depth_m.at<float>(y, x);
       if (!ref.textured.at<uchar>(y, x) || z <= 0) continue;
-      const Eigen::Vector2d ideal = true_camera.map_x.empty()
-                                        ? Eigen::Vector2d(x, y)
-                                        : Eigen::Vector2d(true_camera.map_x.at<float>(y, x),
-                                                          true_camera.map_y.at<float>(y, x));
-      const fovea::Ray ray = fovea::PixelRay(true_camera.world_T_camera, true_camera.ideal, ideal);
+      const fovea::Ray ray = fovea::PixelRay(true_camera.world_T_camera, true_camera.ideal,
+                                             true_camera.IdealPixel(x, y));
       const Eigen::Vector3d p = ray.origin_W + ray.direction_W * (z / ray.direction_W.dot(axis));
       if (rendered(p) || RightCameraSees(geometry, carriages, truth, p))
         ref.stereo_visible.at<uchar>(y, x) = 255;

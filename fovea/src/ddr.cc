@@ -68,10 +68,10 @@ struct LoopState {
   bool has_fixation = false;
   Tessellation current;  ///< the current fixation's
   std::vector<Eigen::Vector3d> refused;
-  /// The last attempt was refused: the next one chooses in the same view
-  /// and map (only the refused points grew).
-  bool last_refused = false;
-  std::optional<SelectionContext> context;  ///< the last choice's
+  /// The last choice's context, kept while attempts are refused (the view,
+  /// the map and the visits stay; only the refused points grow) and
+  /// dropped when a fixation is absorbed.
+  std::optional<SelectionContext> context;
   std::vector<SelectionContext::Visit> visits;
   std::vector<double> share_history;
 };
@@ -93,9 +93,7 @@ SelectionSummary ChooseTarget(const FoveaRun& run, LoopState& state, FixationStr
   }
   const bool in_reference = strategy.View() == StrategyView::kReference;
   const rig::StereoFrame& frame = in_reference ? run.idr.final_frame : state.frame;
-  // After a refused attempt the view, the map and the visits are as they
-  // were: the context stays, and only the refused points grew.
-  const bool same_context = state.last_refused && state.context.has_value();
+  const bool same_context = state.context.has_value();
   if (!same_context) {
     const rig::CameraView& view = frame.left;
     SelectionContext& context = state.context.emplace(
@@ -163,6 +161,7 @@ void Absorb(const FixationResult& r, const rig::CameraView& idr_view,
   // Only the stall rule reads it: a render of the whole map per fixation.
   if (stall_fixations > 0) rec->foveal_share = FovealShare(run->map, idr_view);
   state->has_fixation = true;
+  state->context.reset();
   state->visits.push_back({rec->fixation_W, rec->target_W});
   state->current = rec->tessellation;
 }
@@ -247,7 +246,6 @@ FoveaRun RunFovea(rig::Rig& rig, const StereoMatcher& matcher, const FoveaOption
     rec.time.servo_s = r.servo_wall_s;
     rec.motion_time_s = r.motion_time_s;
     run.motion_time_s += r.motion_time_s;
-    state.last_refused = !r.ok;
     if (!r.ok) {
       rec.why = r.why;
       state.refused.push_back(rec.target_W);

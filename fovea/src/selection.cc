@@ -269,14 +269,6 @@ FixationSelector::Weights FixationSelector::Weigh(const SelectionContext& c) con
   return w;
 }
 
-cv::Mat FixationSelector::Composite(const SelectionContext& c,
-                                    const std::vector<Eigen::Vector3d>& refused_W,
-                                    std::vector<cv::Mat>* each) const {
-  const Weights w = Weigh(c);
-  if (each) *each = w.each;
-  return Composite(c, w, refused_W);
-}
-
 cv::Mat FixationSelector::Composite(const SelectionContext& c, const Weights& w,
                                     const std::vector<Eigen::Vector3d>& refused_W) const {
   // Only the candidates: pixels the map can raytrace, away from the border

@@ -39,7 +39,9 @@ CameraIntrinsics Undistorter::Pinhole(const CameraIntrinsics& k) {
 }
 
 DeliveredPair::DeliveredPair(const RigCalibration& calibration)
-    : geometry(calibration.Geometry()), intrinsics(Undistorter::Pinhole(calibration.left)) {
+    : raw_geometry(calibration.Geometry()),
+      geometry(raw_geometry),
+      intrinsics(Undistorter::Pinhole(calibration.left)) {
   for (const Side side : {Side::kLeft, Side::kRight}) {
     HeadGeometry& head = side == Side::kLeft ? geometry.left : geometry.right;
     // In the head frame the delivered camera's axes are R_hc, the raw

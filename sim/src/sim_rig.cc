@@ -67,6 +67,18 @@ bool SameCamera(const rig::CameraIntrinsics& a, const rig::CameraIntrinsics& b) 
          distortion(a) == distortion(b);
 }
 
+// `pixels` (row by row, rows x cols of them) as CV_32FC1 maps for cv::remap.
+void ToMaps(const std::vector<cv::Point2f>& pixels, int rows, int cols, cv::Mat* map_x,
+            cv::Mat* map_y) {
+  map_x->create(rows, cols, CV_32FC1);
+  map_y->create(rows, cols, CV_32FC1);
+  for (int v = 0, i = 0; v < rows; ++v)
+    for (int u = 0; u < cols; ++u, ++i) {
+      map_x->at<float>(v, u) = pixels[i].x;
+      map_y->at<float>(v, u) = pixels[i].y;
+    }
+}
+
 // For every pixel of an image of `chain.front().first`'s size, where it
 // lands after each (from, to) step of `chain` (CV_32FC1 maps for
 // cv::remap); empty maps when every step maps a camera to itself.
@@ -84,13 +96,7 @@ void PixelMaps(const std::vector<std::pair<rig::CameraIntrinsics, rig::CameraInt
     for (int u = 0; u < first.width_px; ++u) pixels.emplace_back(float(u), float(v));
   for (const auto& [from, to] : chain)
     if (!SameCamera(from, to)) pixels = SameRays(pixels, from, to);
-  map_x->create(first.height_px, first.width_px, CV_32FC1);
-  map_y->create(first.height_px, first.width_px, CV_32FC1);
-  for (int v = 0, i = 0; v < first.height_px; ++v)
-    for (int u = 0; u < first.width_px; ++u, ++i) {
-      map_x->at<float>(v, u) = pixels[i].x;
-      map_y->at<float>(v, u) = pixels[i].y;
-    }
+  ToMaps(pixels, first.height_px, first.width_px, map_x, map_y);
 }
 
 // For every delivered pixel of `undistort`'s camera, the pixel of the true
@@ -103,20 +109,18 @@ void DeliveredToTrue(const rig::Undistorter& undistort, const rig::CameraIntrins
     PixelMaps({{true_k, ideal}}, map_x, map_y);
     return;
   }
-  *map_x = undistort.MapX().clone();
-  *map_y = undistort.MapY().clone();
-  if (SameCamera(true_k, ideal)) return;
+  const cv::Mat &raw_x = undistort.MapX(), &raw_y = undistort.MapY();
+  if (SameCamera(true_k, ideal)) {
+    *map_x = raw_x.clone();
+    *map_y = raw_y.clone();
+    return;
+  }
   std::vector<cv::Point2f> pixels;
-  pixels.reserve(map_x->total());
-  for (int v = 0; v < map_x->rows; ++v)
-    for (int u = 0; u < map_x->cols; ++u)
-      pixels.emplace_back(map_x->at<float>(v, u), map_y->at<float>(v, u));
-  pixels = SameRays(pixels, true_k, ideal);
-  for (int v = 0, i = 0; v < map_x->rows; ++v)
-    for (int u = 0; u < map_x->cols; ++u, ++i) {
-      map_x->at<float>(v, u) = pixels[i].x;
-      map_y->at<float>(v, u) = pixels[i].y;
-    }
+  pixels.reserve(raw_x.total());
+  for (int v = 0; v < raw_x.rows; ++v)
+    for (int u = 0; u < raw_x.cols; ++u)
+      pixels.emplace_back(raw_x.at<float>(v, u), raw_y.at<float>(v, u));
+  ToMaps(SameRays(pixels, true_k, ideal), raw_x.rows, raw_x.cols, map_x, map_y);
 }
 
 // What the rig believes it is: its calibration file, else its design.
@@ -149,7 +153,6 @@ SimRig::SimRig(World* world, const SimRigConfig& config)
   limits_[Axis::kRightBaseline] = {config.carriage_min_m, config.carriage_max_m, lin_steps};
   limits_[Axis::kLeftPan] = limits_[Axis::kRightPan] = {-pan, pan, ang_steps};
   limits_[Axis::kLeftTilt] = limits_[Axis::kRightTilt] = {-tilt, tilt, ang_steps};
-  raw_geometry_ = belief_.Geometry();
 
   // The truth's lens and sensor, and how delivered pixels relate to it.
   const rig::CameraIntrinsics true_k = TrueIntrinsics(config);
@@ -320,7 +323,7 @@ rig::StereoFrame SimRig::Capture(const rig::CaptureOptions& options) {
     }
     view.intrinsics = options.raw ? belief_.Intrinsics(side) : Intrinsics(side);
     // Where the rig believes its camera is: its kinematics at the readings.
-    view.world_T_camera = (options.raw ? raw_geometry_ : delivered_.geometry)
+    view.world_T_camera = (options.raw ? delivered_.raw_geometry : delivered_.geometry)
                               .WorldFromCamera(side, frame.state[side]);
     if (!config_.record_dir.empty()) {
       // Numbered from 0 in capture order: OpenCV's image-sequence reader

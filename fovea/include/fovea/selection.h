@@ -248,11 +248,8 @@ class FixationSelector {
   };
   Weights Weigh(const SelectionContext& context) const;
 
-  /// Product of the criteria, normalized, zero where the map has no point,
-  /// near the border or near a refused point.
-  cv::Mat Composite(const SelectionContext& context, const std::vector<Eigen::Vector3d>& refused_W,
-                    std::vector<cv::Mat>* each = nullptr) const;
-  /// The same from the context's weights.
+  /// Product of the criteria (the context's weights), normalized, zero
+  /// where the map has no point, near the border or near a refused point.
   cv::Mat Composite(const SelectionContext& context, const Weights& weights,
                     const std::vector<Eigen::Vector3d>& refused_W) const;
 

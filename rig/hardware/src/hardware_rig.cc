@@ -82,9 +82,7 @@ cv::Mat CameraSource::Grab() {
 }
 
 HardwareRig::HardwareRig(HardwareRigConfig config)
-    : calibration_(config.calibration),
-      delivered_(calibration_),
-      raw_geometry_(calibration_.Geometry()) {
+    : calibration_(config.calibration), delivered_(calibration_) {
   for (int i = 0; i < kNumAxes; ++i) {
     const IndexerAxis& a = config.stages.axes[i];
     limits_.axes[i] = {a.min, a.max, a.steps_per_unit};
@@ -123,8 +121,8 @@ StereoFrame HardwareRig::Capture(const CaptureOptions& options) {
     // Frames go out as DeliveredPair describes, unless asked for raw.
     view.gray = options.raw ? raw : delivered_.undistort[static_cast<int>(side)].Apply(raw);
     view.intrinsics = options.raw ? calibration_.Intrinsics(side) : Intrinsics(side);
-    view.world_T_camera =
-        (options.raw ? raw_geometry_ : delivered_.geometry).WorldFromCamera(side, state_[side]);
+    view.world_T_camera = (options.raw ? delivered_.raw_geometry : delivered_.geometry)
+                              .WorldFromCamera(side, state_[side]);
   }
   return frame;
 }

@@ -54,7 +54,8 @@ class Undistorter {
 struct DeliveredPair {
   explicit DeliveredPair(const RigCalibration& calibration);
 
-  RigGeometry geometry;                  ///< the calibration's, every mount rotation zero
+  RigGeometry raw_geometry;              ///< the calibration's: raw captures' poses
+  RigGeometry geometry;                  ///< the same, every mount rotation zero
   CameraIntrinsics intrinsics;           ///< both cameras': the left one's, without distortion
   std::array<Undistorter, 2> undistort;  ///< raw -> delivered, per side
   /// Per side, the rotation from the raw camera's axes to the delivered

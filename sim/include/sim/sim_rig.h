@@ -53,6 +53,12 @@ class SimRig : public rig::Rig {
     rig::CameraIntrinsics ideal;
     cv::Mat map_x, map_y;
     Eigen::Matrix3d delivered_R_camera = Eigen::Matrix3d::Identity();
+
+    /// The ideal camera's pixel that shows delivered pixel (x, y).
+    Eigen::Vector2d IdealPixel(int x, int y) const {
+      return map_x.empty() ? Eigen::Vector2d(x, y)
+                           : Eigen::Vector2d(map_x.at<float>(y, x), map_y.at<float>(y, x));
+    }
   };
   TrueCamera True(rig::Side side) const;
 
@@ -62,7 +68,6 @@ class SimRig : public rig::Rig {
   rig::RigLimits limits_;
   rig::RigCalibration belief_;     ///< what it believes it is: raw cameras and heads
   rig::DeliveredPair delivered_;   ///< what Capture delivers, from the belief
-  rig::RigGeometry raw_geometry_;  ///< the belief's, for raw captures
   cv::Size render_size_;           ///< RenderSize(config)
   cv::Mat distort_x_, distort_y_;  ///< render -> distorted image; empty for ideal lenses
   std::array<cv::Mat, 2> gain_;    ///< per pixel: gain x vignetting; empty when ideal

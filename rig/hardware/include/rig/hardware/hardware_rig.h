@@ -60,8 +60,7 @@ class HardwareRig : public Rig {
 
  private:
   RigCalibration calibration_;
-  DeliveredPair delivered_;   // what Capture delivers, from the calibration
-  RigGeometry raw_geometry_;  // the calibration's, for raw captures
+  DeliveredPair delivered_;  // what Capture delivers, from the calibration
   std::unique_ptr<IndexerDriver> driver_;
   std::unique_ptr<CameraSource> left_, right_;
   RigLimits limits_;
