@@ -5,6 +5,8 @@
 #include <limits>
 #include <random>
 
+#include "fovea/foveal.h"
+
 namespace {
 std::vector<fovea::DisparitySample> PlaneSamples(double a, double b, double c, double x0, double y0,
                                                  int size, int step) {
@@ -147,8 +149,12 @@ TEST_CASE("blocks across a depth step split instead of bridging it", "[fovea][pa
                                             : (x < 37 ? 10.f : 20.f) + noise(rng);
   fovea::PlaneFitOptions options;
   options.min_inlier_share = 0.8;
-  const auto whole = fovea::FitBlocks(d, 16, options, /*min_fill_share=*/0, 16, nullptr);
-  const auto split = fovea::FitBlocks(d, 16, options, /*min_fill_share=*/0.5, 4, nullptr);
+  const fovea::BlockOptions paper{/*min_fill_share=*/0, /*min_block_px=*/16,
+                                  /*clip_to_inliers=*/false};
+  const fovea::BlockOptions quarters{/*min_fill_share=*/0.5, /*min_block_px=*/4,
+                                     /*clip_to_inliers=*/false};
+  const auto whole = fovea::FitBlocks(d, 16, options, paper, nullptr);
+  const auto split = fovea::FitBlocks(d, 16, options, quarters, nullptr);
   // A plane may reach over the step by no more than the fit tolerance: at
   // every pixel of its block, the true disparity lies within it of the plane.
   auto worst = [&](const std::vector<fovea::BlockFit>& fits) {
@@ -168,4 +174,69 @@ TEST_CASE("blocks across a depth step split instead of bridging it", "[fovea][pa
   int whole_blocks = 0;
   for (const fovea::BlockFit& b : split) whole_blocks += b.size == 16;
   CHECK(whole_blocks == 12);  // 4 rows x (2 left + 1 right) blocks clear of x = 32..47
+}
+
+TEST_CASE("a block's patch covers its inliers, not the far side of an edge without data",
+          "[fovea][patch]") {
+  // One 16-pixel block: a plane on its left 11 columns; the rest has no
+  // match (the far side of a depth edge, eroded or occluded). The inliers
+  // fill 69% of the block, so it stays whole; its patch must stop where the
+  // data stops instead of extrapolating the plane over the far side.
+  cv::Mat d(16, 16, CV_32F, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 11; ++x) d.at<float>(y, x) = 12.f + 0.05f * x;
+  fovea::PlaneFitOptions options;
+  fovea::BlockOptions blocks;  // the defaults: clipped
+  const auto clipped = fovea::FitBlocks(d, 16, options, blocks, nullptr);
+  REQUIRE(clipped.size() == 1);
+  CHECK(clipped[0].footprint.isApprox(Eigen::Vector4d(-0.5, -0.5, 10.5, 15.5)));
+  CHECK(clipped[0].fit(5, 5) == Approx(12.25).margin(1e-9));
+  blocks.clip_to_inliers = false;  // the paper's tiling: the whole block
+  const auto tiled = fovea::FitBlocks(d, 16, options, blocks, nullptr);
+  REQUIRE(tiled.size() == 1);
+  CHECK(tiled[0].footprint.isApprox(Eigen::Vector4d(-0.5, -0.5, 15.5, 15.5)));
+}
+
+TEST_CASE("erosion at disparity jumps drops the nearer side's edge, whatever NaNs lie near",
+          "[fovea][patch]") {
+  // A nearer surface (disparity 20) left of x = 20, a farther one (10)
+  // right of it, unmatched pixels (NaN) sprinkled over both, and one
+  // isolated mismatch (5) inside the nearer surface: every nearer pixel
+  // within 3 pixels of the farther surface goes, nothing else does.
+  cv::Mat d(24, 40, CV_32F);
+  for (int y = 0; y < d.rows; ++y)
+    for (int x = 0; x < d.cols; ++x)
+      d.at<float>(y, x) = (x * 7 + y * 3) % 5 == 0 ? std::numeric_limits<float>::quiet_NaN()
+                                                   : (x < 20 ? 20.f : 10.f);
+  d.at<float>(12, 8) = 5.f;
+  cv::Mat eroded = d.clone();
+  const int n = fovea::ErodeAtDisparityJumps(3, 1.5, &eroded);
+  int expected = 0;
+  for (int y = 0; y < d.rows; ++y)
+    for (int x = 0; x < d.cols; ++x) {
+      const float before = d.at<float>(y, x), after = eroded.at<float>(y, x);
+      if (std::isnan(before)) {
+        CHECK(std::isnan(after));
+        continue;
+      }
+      // The rule written plainly: a farther pixel within the radius that has
+      // at least 3 neighbours of its own surface.
+      auto surface = [&](int u, int v) {
+        int n = 0;
+        for (int j = std::max(0, v - 1); j <= std::min(d.rows - 1, v + 1); ++j)
+          for (int i = std::max(0, u - 1); i <= std::min(d.cols - 1, u + 1); ++i)
+            n += (i != u || j != v) && std::abs(d.at<float>(j, i) - d.at<float>(v, u)) <= 1.5f;
+        return n >= 3;
+      };
+      bool near_jump = false;
+      for (int v = std::max(0, y - 3); v <= std::min(d.rows - 1, y + 3); ++v)
+        for (int u = std::max(0, x - 3); u <= std::min(d.cols - 1, x + 3); ++u)
+          near_jump = near_jump || (before - d.at<float>(v, u) > 1.5f && surface(u, v));
+      expected += near_jump;
+      INFO("pixel (" << x << ", " << y << ")");
+      CHECK(std::isnan(after) == near_jump);
+      CHECK(near_jump == (x >= 17 && x < 20));  // the mismatch at (8, 12) costs nothing
+    }
+  CHECK(n == expected);
+  CHECK(expected > 0);
 }

@@ -3,6 +3,7 @@
 
 #include <catch2/catch.hpp>
 
+#include "fovea/patch.h"
 #include "scenes/catalog.h"
 
 TEST_CASE("reference view: the strip past a near left edge is out of every right camera's sight",
@@ -41,4 +42,48 @@ TEST_CASE("reference view: with no near edge to hide behind, every textured pixe
   const experiments::ReferenceView ref = experiments::MakeReferenceView(sim->rig(), *sim);
   REQUIRE(ref.textured_pixels > 0);
   CHECK(ref.stereo_visible_pixels >= 0.99 * ref.textured_pixels);
+}
+
+TEST_CASE("map score: the pixels near edges are split by the source of the patch seen",
+          "[experiments][scoring][slow]") {
+  auto sim = scenes::LoadScene("three_surfaces", {});
+  const experiments::ReferenceView ref = experiments::MakeReferenceView(sim->rig(), *sim);
+  const rig::CameraIntrinsics& k = ref.view.intrinsics;
+  // A fronto-parallel quad over image columns [u0, u1), all rows, at depth z.
+  auto quad = [&](double u0, double u1, double z, fovea::PatchLevel level, int resolution) {
+    fovea::Patch p;
+    p.level = level;
+    p.resolution_level = resolution;
+    const double us[4] = {u0, u1, u1, u0},
+                 vs[4] = {-0.5, -0.5, k.height_px - 0.5, k.height_px - 0.5};
+    for (int c = 0; c < 4; ++c)
+      p.corners_W[c] =
+          ref.view.world_T_camera *
+          Eigen::Vector3d((us[c] - k.cx_px) / k.fx_px * z, (vs[c] - k.cy_px) / k.fy_px * z, z);
+    return p;
+  };
+  // IDR over the whole view at the back plane's depth, a peripheral patch
+  // (resolution 1) in front of it over the left third, a foveal one nearer
+  // still over the middle third: each is the nearest where it lies.
+  const double w = k.width_px;
+  fovea::PatchMap map;
+  map.Add(quad(-0.5, w - 0.5, 1.2, fovea::PatchLevel::kIdr, 0));
+  map.Add(quad(-0.5, w / 3, 0.9, fovea::PatchLevel::kPeripheral, 1));
+  map.Add(quad(w / 3, 2 * w / 3, 0.55, fovea::PatchLevel::kFoveal, 0));
+  const experiments::MapScore score = experiments::ScoreMap(map, ref, sim->truth(), 0.06, false);
+  const nlohmann::json j = experiments::ScoreJson(score);
+  const long edge_pixels = j["edge_pixels"];
+  REQUIRE(edge_pixels > 0);
+  long pixels = 0;
+  double bad = 0;
+  for (const char* source : {"idr", "0", "1"}) {
+    INFO("source " << source);
+    REQUIRE(j["edge_by_source"].contains(source));
+    const long n = j["edge_by_source"][source]["pixels"];
+    CHECK(n > 0);  // the blocks' edges lie in all three thirds
+    pixels += n;
+    bad += n * j["edge_by_source"][source]["bad_share"].get<double>();
+  }
+  CHECK(pixels == edge_pixels);
+  CHECK(bad == Approx(edge_pixels * j["edge_bad_share"].get<double>()).epsilon(1e-9));
 }

@@ -229,9 +229,9 @@ MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref,
   cv::Mat depth, ids;
   map.Render(ref.view.world_T_camera, ref.view.intrinsics, &depth, &ids);
   const double f = ref.view.intrinsics.fx_px;
-  Accumulator all, edges;
+  Accumulator all, edges, edges_idr;
   std::array<Accumulator, 3> level;
-  std::array<Accumulator, 6> resolution;
+  std::array<Accumulator, 6> resolution, edges_resolution;
   struct PerSurface {
     long pixels = 0, mapped = 0, foveal = 0, stereo_visible = 0;
     Accumulator errors;
@@ -256,10 +256,16 @@ MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref,
       if (lv == static_cast<int>(fovea::PatchLevel::kFoveal)) ++foveal, ++ps.foveal;
       const double step = zt * zt / (f * baseline_m);
       all.Add(z, zt, step);
-      if (ref.near_edge.at<uchar>(y, x)) edges.Add(z, zt, step);
+      const bool near_edge = ref.near_edge.at<uchar>(y, x);
+      if (near_edge) edges.Add(z, zt, step);
       level[lv].Add(z, zt, step);
-      if (map[id].level != fovea::PatchLevel::kIdr)
-        resolution[std::clamp(map[id].resolution_level, 0, 5)].Add(z, zt, step);
+      if (map[id].level == fovea::PatchLevel::kIdr) {
+        if (near_edge) edges_idr.Add(z, zt, step);
+      } else {
+        const int r = std::clamp(map[id].resolution_level, 0, 5);
+        resolution[r].Add(z, zt, step);
+        if (near_edge) edges_resolution[r].Add(z, zt, step);
+      }
       ps.errors.Add(z, zt, step);
     }
   const long total = ref.textured_pixels;
@@ -271,6 +277,8 @@ MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref,
   s.overall = all.Figures(total);
   s.good_coverage = total ? double(s.overall.pixels - s.overall.bad) / total : 0;
   s.near_edges = edges.Figures(total);
+  s.near_edges_idr = edges_idr.Figures(total);
+  for (int i = 0; i < 6; ++i) s.near_edges_by_resolution[i] = edges_resolution[i].Figures(total);
   for (int i = 0; i < 3; ++i) s.by_level[i] = level[i].Figures(total);
   for (int i = 0; i < 6; ++i) s.by_resolution[i] = resolution[i].Figures(total);
   for (const auto& [geom, ps] : surfaces) {
@@ -336,6 +344,14 @@ nlohmann::json ScoreJson(const MapScore& s) {
   j["bad_share"] = BadShare(s.overall);
   j["edge_bad_share"] = BadShare(s.near_edges);
   j["edge_pixels"] = s.near_edges.pixels;
+  // Where the pixels near edges come from: IDR, or a resolution level.
+  j["edge_by_source"]["idr"] = {{"pixels", s.near_edges_idr.pixels},
+                                {"bad_share", BadShare(s.near_edges_idr)}};
+  for (int i = 0; i < 6; ++i)
+    if (s.near_edges_by_resolution[i].pixels > 0)
+      j["edge_by_source"][std::to_string(i)] = {
+          {"pixels", s.near_edges_by_resolution[i].pixels},
+          {"bad_share", BadShare(s.near_edges_by_resolution[i])}};
   for (int i = 0; i < 3; ++i)
     j["by_level"][fovea::PatchLevelName(static_cast<fovea::PatchLevel>(i))] =
         ErrorJson(s.by_level[i]);

@@ -23,8 +23,8 @@ void FovealOptions::Check() const {
   rig::CheckParam(params::kFovealSilentCheckLevel, silent_check_level);
   rig::CheckParam(params::kFovealEdgeErosionPx, edge_erosion_px);
   rig::CheckParam(params::kFovealEdgeJumpPx, edge_jump_px);
-  rig::CheckParam(params::kFovealMinFillShare, min_fill_share);
-  rig::CheckParam(params::kFovealMinBlockPx, min_block_px);
+  rig::CheckParam(params::kFovealMinFillShare, blocks.min_fill_share);
+  rig::CheckParam(params::kFovealMinBlockPx, blocks.min_block_px);
   plane_fit.Check(params::kFovealFitMinSupport, params::kFovealFitTolerancePx,
                   params::kFovealFitMinInlierShare);
   // Set from idr.z_min_m (ResolvedFixationOptions), not a parameter of its own.
@@ -249,15 +249,27 @@ int DropOutsideBand(const SilentCheck& check, const Level& level, const SearchRa
   return dropped;
 }
 
-// Window matching carries a nearer surface's disparity over a farther one's
-// pixels beside their edge (a window straddling the edge is dominated by the
-// nearer texture, in both directions of the left-right check): invalidates
-// the pixels within `radius` of a pixel whose disparity is more than
-// `jump_px` smaller. Returns how many.
+}  // namespace
+
 int ErodeAtDisparityJumps(int radius, double jump_px, cv::Mat* disparity) {
   if (radius <= 0) return 0;
-  cv::Mat farthest = disparity->clone();
-  farthest.setTo(std::numeric_limits<float>::infinity(), farthest != farthest);  // NaN: no limit
+  // The limits: each pixel's disparity where it belongs to a surface, at
+  // least kSupport of its 8 neighbours within jump_px of it; +inf (no limit)
+  // where it is NaN or an isolated mismatch, which would otherwise cost the
+  // good matches around it.
+  constexpr int kSupport = 3;
+  const cv::Mat& d = *disparity;
+  cv::Mat farthest(d.size(), CV_32F, cv::Scalar(std::numeric_limits<float>::infinity()));
+  for (int y = 0; y < d.rows; ++y)
+    for (int x = 0; x < d.cols; ++x) {
+      const float here = d.at<float>(y, x);
+      if (!std::isfinite(here)) continue;
+      int support = 0;
+      for (int v = std::max(0, y - 1); v <= std::min(d.rows - 1, y + 1); ++v)
+        for (int u = std::max(0, x - 1); u <= std::min(d.cols - 1, x + 1); ++u)
+          support += (u != x || v != y) && std::abs(d.at<float>(v, u) - here) <= jump_px;
+      if (support >= kSupport) farthest.at<float>(y, x) = here;
+    }
   cv::erode(farthest, farthest,
             cv::getStructuringElement(cv::MORPH_RECT, {2 * radius + 1, 2 * radius + 1}));
   int n = 0;
@@ -272,9 +284,12 @@ int ErodeAtDisparityJumps(int radius, double jump_px, cv::Mat* disparity) {
   return n;
 }
 
-// The patch of one fitted block of a level: it spans its whole block
-// (blocks that tile the image leave no cracks), its corners triangulated
-// from both rays; nullopt if a corner's rays do not meet.
+namespace {
+
+// The patch of one fitted block of a level: it spans the block's footprint
+// (the whole block, which tiles the image without cracks, or its inliers'
+// extent), its corners triangulated from both rays; nullopt if a corner's
+// rays do not meet.
 std::optional<Patch> BlockPatch(const rig::StereoFrame& frame, const Level& level,
                                 const BlockFit& b, int fixation) {
   const rig::CameraView& left = frame.left;
@@ -286,8 +301,9 @@ std::optional<Patch> BlockPatch(const rig::StereoFrame& frame, const Level& leve
   p.fixation = fixation;
   p.fit_rms_px = b.fit.rms_px;
   p.support = b.fit.support;
-  const double xs[4] = {b.x - 0.5, b.x + b.size - 0.5, b.x + b.size - 0.5, b.x - 0.5};
-  const double ys[4] = {b.y - 0.5, b.y - 0.5, b.y + b.size - 0.5, b.y + b.size - 0.5};
+  const Eigen::Vector4d& f = b.footprint;
+  const double xs[4] = {f(0), f(2), f(2), f(0)};
+  const double ys[4] = {f(1), f(1), f(3), f(3)};
   for (int c = 0; c < 4; ++c) {
     const double d = b.fit(xs[c], ys[c]) * s;
     const double u = (xs[c] + 0.5) * s - 0.5, v = (ys[c] + 0.5) * s - 0.5;
@@ -324,8 +340,7 @@ int LevelPatches(const rig::StereoFrame& frame, const Tessellation& t, const Lev
     return level.rect.contains(centre) && !(level.index > 0 && inner.contains(centre));
   };
   int added = 0;
-  for (const BlockFit& b : FitBlocks(disparity, size, fit_options, options.min_fill_share,
-                                     options.min_block_px, in_level))
+  for (const BlockFit& b : FitBlocks(disparity, size, fit_options, options.blocks, in_level))
     if (const auto p = BlockPatch(frame, level, b, fixation)) {
       patches->Add(*p);
       ++added;

@@ -121,7 +121,7 @@ std::optional<PlaneFit> FitDisparityPlane(const std::vector<DisparitySample>& sa
 namespace {
 
 void FitBlock(const cv::Mat& disparity, int bx, int by, int size, const PlaneFitOptions& options,
-              double min_fill_share, int min_block_px, std::vector<BlockFit>* out) {
+              const BlockOptions& blocks, std::vector<BlockFit>* out) {
   PlaneFitOptions o = options;
   o.min_support = std::min(options.min_support, (3 * size * size) / 4);
   std::vector<DisparitySample> samples;
@@ -131,36 +131,39 @@ void FitBlock(const cv::Mat& disparity, int bx, int by, int size, const PlaneFit
       if (std::isfinite(d)) samples.push_back({double(x), double(y), d});
     }
   if (samples.empty()) return;
-  const auto fit = FitDisparityPlane(samples, bx, by, size, o);
+  Eigen::Vector4d box;
+  const auto fit = FitDisparityPlane(samples, bx, by, size, o, &box);
   // One plane for the whole block when its inliers fill it and it has next
   // to no outliers (measurements of another surface); else its quarters
   // are tried, and a smallest block that is not whole is left out.
+  const double fill = blocks.min_fill_share;
   const int outliers = fit ? static_cast<int>(samples.size()) - fit->support : 0;
-  const bool whole = min_fill_share <= 0
-                         ? fit.has_value()
-                         : fit && fit->support >= min_fill_share * size * size &&
-                               outliers <= std::max(1.0, 0.05 * double(samples.size()));
+  const bool whole = fill <= 0 ? fit.has_value()
+                               : fit && fit->support >= fill * size * size &&
+                                     outliers <= std::max(1.0, 0.05 * double(samples.size()));
   if (whole) {
-    out->push_back({bx, by, size, *fit});
+    BlockFit b{bx, by, size, *fit};
+    b.footprint = blocks.clip_to_inliers
+                      ? Eigen::Vector4d(box(0) - 0.5, box(1) - 0.5, box(2) + 0.5, box(3) + 0.5)
+                      : Eigen::Vector4d(bx - 0.5, by - 0.5, bx + size - 0.5, by + size - 0.5);
+    out->push_back(b);
     return;
   }
   const int half = size / 2;
-  if (min_fill_share <= 0 || half < min_block_px) return;
+  if (fill <= 0 || half < blocks.min_block_px) return;
   for (int q = 0; q < 4; ++q)
-    FitBlock(disparity, bx + (q % 2) * half, by + (q / 2) * half, half, options, min_fill_share,
-             min_block_px, out);
+    FitBlock(disparity, bx + (q % 2) * half, by + (q / 2) * half, half, options, blocks, out);
 }
 
 }  // namespace
 
 std::vector<BlockFit> FitBlocks(const cv::Mat& disparity, int size, const PlaneFitOptions& options,
-                                double min_fill_share, int min_block_px,
+                                const BlockOptions& blocks,
                                 const std::function<bool(int x, int y, int size)>& keep) {
   std::vector<BlockFit> out;
   for (int by = 0; by + size <= disparity.rows; by += size)
     for (int bx = 0; bx + size <= disparity.cols; bx += size)
-      if (!keep || keep(bx, by, size))
-        FitBlock(disparity, bx, by, size, options, min_fill_share, min_block_px, &out);
+      if (!keep || keep(bx, by, size)) FitBlock(disparity, bx, by, size, options, blocks, &out);
   return out;
 }
 

@@ -52,11 +52,11 @@ struct FovealOptions {
   int edge_erosion_px = 3;
   double edge_jump_px = 1.5;
   /// Beyond the paper: a block becomes one patch only if its inliers fill
-  /// this share of it; else it is split into quarters (down to min_block_px
-  /// level pixels), so that no patch reaches over a depth edge or a strip
-  /// without data (0: the paper's whole blocks).
-  double min_fill_share = 0.5;
-  int min_block_px = 4;
+  /// enough of it, else it is split into quarters, and a patch covers only
+  /// its inliers' extent, so that no patch reaches over a depth edge or a
+  /// strip without data (BlockOptions; min_fill_share = 0 and
+  /// clip_to_inliers = false: the paper's whole blocks).
+  BlockOptions blocks;
   /// Beyond the paper (issue 20): tessellate, match and triangulate in the
   /// pair's fixation frame (ToFixationFrame: both cameras turned virtually
   /// so that the rows of a tilted verged pair no longer twist against each
@@ -100,6 +100,16 @@ struct FovealResult {
   double silent_check_time_s = 0;  ///< the wide search (FovealOptions::silent_near_m)
   FoveaFigures Fovea() const;
 };
+
+/// Window matching carries a nearer surface's disparity over a farther
+/// one's pixels beside their edge (a window straddling the edge is dominated
+/// by the nearer texture, in both directions of the left-right check):
+/// invalidates (sets to NaN) the pixels of `disparity` (CV_32F, NaN = none)
+/// within `radius` pixels of a pixel whose disparity is more than `jump_px`
+/// smaller. Only a surface sets a limit: a pixel with at least 3 of its 8
+/// neighbours within `jump_px` of it; NaN pixels and isolated mismatches do
+/// not. Returns how many (FovealOptions::edge_erosion_px).
+int ErodeAtDisparityJumps(int radius, double jump_px, cv::Mat* disparity);
 
 /// Matches a verged pair that fixates p_W, level by level, coarse to fine,
 /// with the range at each pixel bounded by `map` (or by Z_T where the map is

@@ -178,6 +178,10 @@ inline constexpr ParamSpec kFovealMinFillShare{
     0, 1};
 inline constexpr ParamSpec kFovealMinBlockPx{
     "foveal.min_block_px", "the smallest quarter a block is split into, level pixels", 2, 64};
+inline constexpr ParamSpec kFovealClipToInliers{
+    "foveal.clip_to_inliers",
+    "beyond the paper: a block's patch covers only its inliers' bounding box, not the whole "
+    "block (false = the paper's tiling blocks)"};
 inline constexpr ParamSpec kFovealRectify{
     "foveal.rectify",
     "beyond the paper: servo, tessellate and match in the pair's fixation frame (both images "

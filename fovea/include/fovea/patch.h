@@ -105,20 +105,33 @@ std::optional<PlaneFit> FitDisparityPlane(const std::vector<DisparitySample>& sa
 struct BlockFit {
   int x = 0, y = 0, size = 0;  ///< the block: [x, x + size) x [y, y + size), image pixels
   PlaneFit fit;
+  /// The patch's extent in the image, pixel edges (x0, y0, x1, y1): the
+  /// block, or with BlockOptions::clip_to_inliers the inliers' bounding box.
+  Eigen::Vector4d footprint = Eigen::Vector4d::Zero();
+};
+
+/// How FitBlocks turns blocks into planes (beyond the paper: its defaults;
+/// min_fill_share = 0 and clip_to_inliers = false give the paper's rule).
+struct BlockOptions {
+  /// A block becomes one plane only if its inliers fill this share of it
+  /// and next to none of its measurements are outliers (at most 5%, at least
+  /// one); otherwise (a depth edge inside it, a strip without matches along
+  /// one) it is split into quarters, recursively down to `min_block_px`,
+  /// and a smallest block that is not whole is left out, so that no plane
+  /// spans two surfaces. 0: every block whose fit succeeds.
+  double min_fill_share = 0.5;
+  int min_block_px = 4;
+  /// A plane covers only its inliers' bounding box, not its whole block: a
+  /// block whose data stops short of a side (the far side of a depth edge,
+  /// unmatched or eroded) does not extrapolate its plane over the rest.
+  bool clip_to_inliers = true;
 };
 
 /// Planes over the blocks of `size` pixels that tile `disparity` (CV_32F,
-/// NaN = no measurement) that `keep` accepts. With min_fill_share > 0 a
-/// block becomes one plane only if its inliers fill that share of it and
-/// next to none of its measurements are outliers (at most 5%, at least one);
-/// otherwise (a depth edge inside it, a strip without matches along one) it
-/// is split into quarters, recursively down to `min_block_px`, and a
-/// smallest block that is not whole is left out, so that no plane spans two
-/// surfaces. With min_fill_share = 0, every block whose fit succeeds (the
-/// paper's rule). The fit's min_support shrinks with the block (to 3/4 of
-/// its pixels).
+/// NaN = no measurement) that `keep` accepts, by the rules of `blocks`. The
+/// fit's min_support shrinks with the block (to 3/4 of its pixels).
 std::vector<BlockFit> FitBlocks(const cv::Mat& disparity, int size, const PlaneFitOptions& options,
-                                double min_fill_share, int min_block_px,
+                                const BlockOptions& blocks,
                                 const std::function<bool(int x, int y, int size)>& keep);
 
 /// Result of a ray query.

@@ -88,6 +88,10 @@ struct MapScore {
   double good_coverage = 0;
   /// The mapped pixels within kEdgeRadiusPx of a depth discontinuity.
   ErrorFigures near_edges;
+  /// The same pixels by the patch seen: IDR, or the resolution level of a
+  /// foveal or peripheral patch (where the bleeding across edges comes from).
+  ErrorFigures near_edges_idr;
+  std::array<ErrorFigures, 6> near_edges_by_resolution;
   std::array<ErrorFigures, 3> by_level;  ///< by PatchLevel of the patch seen
   /// Foveal and peripheral pixels by the resolution level of the patch seen
   /// (0 = full resolution; level k samples every 2^k pixels).
