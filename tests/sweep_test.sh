@@ -2,11 +2,12 @@
 # A sweep killed part-way (SIGKILL) and restarted with the same command, and
 # the same sweep run as two shards merged by fovea collect, both give the CSV
 # of an uninterrupted sweep in every column but the wall-clock times.
-# Usage: sweep_test.sh FOVEA SWEEP_FILE WORK_DIR
+# Usage: sweep_test.sh FOVEA SWEEP_FILE WORK_DIR ROWS (the sweep's run count)
 set -euo pipefail
 fovea=$1
 sweep=$2
 work=$3
+rows=$4
 rm -rf "$work"
 mkdir -p "$work"
 fail() { echo "FAIL: $*" >&2; exit 1; }
@@ -20,7 +21,7 @@ echo "== uninterrupted sweep"
 [ -f "$work/full/results.csv" ] || fail "no results.csv"
 [ -f "$work/full/report.html" ] || fail "no report.html"
 total=$(($(wc -l < "$work/full/results.csv") - 1))
-[ "$total" -eq 16 ] || fail "expected 16 rows, got $total"
+[ "$total" -eq "$rows" ] || fail "expected $rows rows, got $total"
 grep -q "<svg" "$work/full/report.html" || fail "the sweep report has no plot"
 strip "$work/full/results.csv" > "$work/full.csv"
 if cmp -s "$work/full/results.csv" "$work/full.csv"; then fail "no wall-clock columns were stripped"; fi
