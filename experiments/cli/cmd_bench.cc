@@ -122,6 +122,7 @@ struct BenchFixationArgs {
   std::vector<std::string> point{"0", "0.89", "0"};
   int repeat = 5;
   bool json = false;
+  std::vector<std::string> set;  ///< KEY=VALUE parameters
 };
 
 // The whole-frame matchers against the fovea's, on one fixation's frame over
@@ -187,6 +188,7 @@ WholeFrame MatchWholeFrame(const fovea::FixationResult& r, const fovea::Nl1Match
 
 int BenchFixation(const BenchFixationArgs& args) {
   RunConfig config;  // the run's defaults: noise on
+  SetParams(&config, args.set);
   args.scene.ApplyTo(&config);
   config.Check();
   const Eigen::Vector3d p(*ParseNumber(args.point[0]), *ParseNumber(args.point[1]),
@@ -266,6 +268,8 @@ void AddBenchFixationCommand(CLI::App& bench, std::function<int()>* run) {
   cmd->add_option("--repeat", args->repeat, "times each matcher runs; the median")
       ->check(CLI::Range(1, 1000))
       ->capture_default_str();
+  cmd->add_option("--set", args->set,
+                  "KEY=VALUE: set one parameter (repeatable), e.g. nl1.cost=window_mean");
   cmd->add_flag("--json", args->json, "one JSON object on stdout");
   cmd->callback([args, run] { *run = [args] { return BenchFixation(*args); }; });
 }

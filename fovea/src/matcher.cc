@@ -39,16 +39,21 @@ constexpr int kStripRows = 16;
 // The matching costs of one strip of rows: the cost at (x, y, d) is that of
 // the left window centred at (x, y) against the right window at (x - d, y),
 // +inf where the right window leaves the image. Each disparity d holds the
-// columns [x0[d], x0[d] + width[d]), x fastest (Row).
+// columns [x0[d], x0[d] + width[d]), x fastest (Row). Row y needs d only
+// over [RowFirst(y, d), RowEnd(y, d)), a part of those (empty: first >=
+// end); a fill that costs O(window area) computes only that part.
 struct CostVolume {
   int y0 = 0, rows = 0, dlo = 0, nd = 0;
   std::vector<int> x0, width;
   std::vector<size_t> offset;
   std::vector<float> c;
+  std::vector<int> row_first, row_end;  ///< [(y - y0) * nd + d - dlo]
   float* Row(int y, int d) {
     const int i = d - dlo;
     return &c[offset[i] + static_cast<size_t>(y - y0) * width[i]];
   }
+  int RowFirst(int y, int d) const { return row_first[(y - y0) * nd + d - dlo]; }
+  int RowEnd(int y, int d) const { return row_end[(y - y0) * nd + d - dlo]; }
 };
 
 // The pre-normalized cost: each image less its local mean (a, b), then
@@ -105,9 +110,93 @@ FOVEA_SIMD_CLONES void FillPrenormalized(const cv::Mat& a, const cv::Mat& b, int
   }
 }
 
+// The zero-mean SSD: sum ((L - mean L) - (R - mean R))^2 with both means
+// over the windows compared, as the paper's cost, but squared, so that it
+// runs: with D = L - R over the window of N pixels it is
+// sum D^2 - (sum D)^2 / N, two box sums of one difference image per
+// disparity. The sums are exact integers (8-bit images; column sums run
+// down the strip, then (2h + 1)-wide row sums); the cost is the root mean
+// square, sqrt(N sum D^2 - (sum D)^2) / N, in grey levels like the L1
+// costs, and V-shaped about a match like them (the equiangular sub-pixel
+// fit applies). O(1) per pixel and disparity in the window's area.
+FOVEA_SIMD_CLONES void FillZeroMeanSsd(const cv::Mat& l, const cv::Mat& r, int h, CostVolume* v) {
+  const int n = 2 * h + 1, cols = l.cols;
+  const double area = static_cast<double>(n) * n;
+  const float scale = static_cast<float>(1.0 / area);
+  std::vector<int32_t> diff, s1, s2, w1, w2;
+  for (int d = v->dlo; d < v->dlo + v->nd; ++d) {
+    const int width = v->width[d - v->dlo];
+    if (width <= 0) continue;
+    const int x0 = v->x0[d - v->dlo], span = width + 2 * h;
+    diff.resize(static_cast<size_t>(v->rows + 2 * h) * span);
+    s1.assign(span, 0);
+    s2.assign(span, 0);
+    w1.resize(width);
+    w2.resize(width);
+    // Columns whose right pixel x - d lies in the image; the rest are
+    // masked below and only need to be finite.
+    const int first = std::clamp(d - (x0 - h), 0, span),
+              last = std::clamp(cols + d - (x0 - h), 0, span);
+    for (int row = 0; row < v->rows + 2 * h; ++row) {
+      const uchar* __restrict pa = l.ptr<uchar>(v->y0 - h + row) + (x0 - h);
+      const uchar* __restrict pb = r.ptr<uchar>(v->y0 - h + row) + (x0 - h - d);
+      int32_t* __restrict out = &diff[static_cast<size_t>(row) * span];
+      std::fill(out, out + first, 0);
+      for (int i = first; i < last; ++i) out[i] = int32_t{pa[i]} - int32_t{pb[i]};
+      std::fill(out + last, out + span, 0);
+    }
+    int32_t* __restrict c1 = s1.data();
+    int32_t* __restrict c2 = s2.data();
+    for (int k = 0; k < n - 1; ++k) {
+      const int32_t* __restrict dk = &diff[static_cast<size_t>(k) * span];
+      for (int i = 0; i < span; ++i) {
+        c1[i] += dk[i];
+        c2[i] += dk[i] * dk[i];
+      }
+    }
+    // Right windows inside the image: x - d - h >= 0 and x - d + h < cols.
+    const int valid0 = std::clamp(d + h - x0, 0, width),
+              valid1 = std::clamp(cols + d - h - x0, valid0, width);
+    int32_t* __restrict r1 = w1.data();
+    int32_t* __restrict r2 = w2.data();
+    for (int y = 0; y < v->rows; ++y) {
+      const int32_t* __restrict enter = &diff[static_cast<size_t>(y + n - 1) * span];
+      for (int i = 0; i < span; ++i) {
+        c1[i] += enter[i];
+        c2[i] += enter[i] * enter[i];
+      }
+      float* __restrict out = v->Row(v->y0 + y, d);
+      std::fill(out, out + valid0, kInf);
+      for (int i = valid0; i < valid1; ++i) {
+        r1[i] = c1[i];
+        r2[i] = c2[i];
+      }
+      for (int k = 1; k < n; ++k)
+        for (int i = valid0; i < valid1; ++i) {
+          r1[i] += c1[i + k];
+          r2[i] += c2[i + k];
+        }
+      // N sum D^2 and (sum D)^2 reach 2^37 for the largest window: their
+      // difference is exact in doubles, then rounded once to a float.
+      for (int i = valid0; i < valid1; ++i) {
+        const double sum = r1[i];
+        out[i] = std::sqrt(static_cast<float>(area * r2[i] - sum * sum)) * scale;
+      }
+      std::fill(out + valid1, out + width, kInf);
+      const int32_t* __restrict leave = &diff[static_cast<size_t>(y) * span];
+      for (int i = 0; i < span; ++i) {
+        c1[i] -= leave[i];
+        c2[i] -= leave[i] * leave[i];
+      }
+    }
+  }
+}
+
 // The paper's cost: sum |(L - mean L) - (R - mean R)| with both means over
 // the windows being compared, which no running sum can share: O(window
-// area) per pixel and disparity, but each disparity's row at once, the
+// area) per pixel and disparity. Per disparity, the strip's differences
+// L - R are taken once; each row then sums |(L - R) - (mean L - mean R)|
+// over the window only at the columns it needs (CostVolume::RowFirst), the
 // window's offsets a loop over contiguous columns that the compiler
 // vectorizes (each pixel's sum in the same order as one pixel at a time).
 // `l`, `r`: the images as CV_32F; `ml`, `mr`: their window means.
@@ -115,36 +204,53 @@ FOVEA_SIMD_CLONES void FillWindowMean(const cv::Mat& l, const cv::Mat& r, const 
                                       const cv::Mat& mr, int h, CostVolume* v) {
   const float scale = 1.0f / ((2 * h + 1) * (2 * h + 1));
   const int cols = l.cols;
-  std::vector<float> offset, acc;
+  std::vector<float> diff, offset, acc;
   for (int d = v->dlo; d < v->dlo + v->nd; ++d) {
     const int x0 = v->x0[d - v->dlo], width = v->width[d - v->dlo];
     if (width <= 0) continue;
     // Right windows inside the image: x - d - h >= 0 and x - d + h < cols.
     const int valid0 = std::clamp(d + h - x0, 0, width);
     const int valid1 = std::clamp(cols + d - h - x0, valid0, width);
-    const int n = valid1 - valid0, first = x0 + valid0;
-    offset.resize(n);
-    acc.resize(n);
+    // L - R over the strip's rows and their windows, at the columns
+    // [x0 + valid0 - h, x0 + valid1 + h), where the right pixel lies in
+    // the image.
+    const int first = x0 + valid0 - h, span = valid1 - valid0 + 2 * h;
+    if (valid1 > valid0) {
+      diff.resize(static_cast<size_t>(v->rows + 2 * h) * span);
+      for (int row = 0; row < v->rows + 2 * h; ++row) {
+        const float* __restrict pl = l.ptr<float>(v->y0 - h + row) + first;
+        const float* __restrict pr = r.ptr<float>(v->y0 - h + row) + first - d;
+        float* __restrict out = &diff[static_cast<size_t>(row) * span];
+        for (int i = 0; i < span; ++i) out[i] = pl[i] - pr[i];
+      }
+    }
+    offset.resize(width);
+    acc.resize(width);
     for (int y = v->y0; y < v->y0 + v->rows; ++y) {
       float* out = v->Row(y, d);
-      std::fill(out, out + valid0, kInf);
-      std::fill(out + valid1, out + width, kInf);
+      // The row's columns, as offsets into the strip's [x0, x0 + width).
+      const int c0 = std::clamp(v->RowFirst(y, d) - x0, valid0, valid1);
+      const int c1 = std::clamp(v->RowEnd(y, d) - x0, c0, valid1);
+      std::fill(out, out + c0, kInf);
+      std::fill(out + c1, out + width, kInf);
+      const int n = c1 - c0;
       if (n <= 0) continue;
-      const float* __restrict pml = ml.ptr<float>(y) + first;
-      const float* __restrict pmr = mr.ptr<float>(y) + first - d;
+      const float* __restrict pml = ml.ptr<float>(y) + x0 + c0;
+      const float* __restrict pmr = mr.ptr<float>(y) + x0 + c0 - d;
       float* __restrict o = offset.data();
       float* __restrict c = acc.data();
       for (int i = 0; i < n; ++i) {
         o[i] = pml[i] - pmr[i];
         c[i] = 0;
       }
-      for (int dy = -h; dy <= h; ++dy) {
-        const float* __restrict pl = l.ptr<float>(y + dy) + first;
-        const float* __restrict pr = r.ptr<float>(y + dy) + first - d;
-        for (int dx = -h; dx <= h; ++dx)
-          for (int i = 0; i < n; ++i) c[i] += std::abs(pl[i + dx] - pr[i + dx] - o[i]);
+      for (int dy = 0; dy <= 2 * h; ++dy) {
+        // diff's row of y - h + dy, from the column c0 - h of [x0, x0 + width).
+        const float* __restrict pd =
+            &diff[static_cast<size_t>(y - v->y0 + dy) * span] + (c0 - valid0);
+        for (int dx = 0; dx <= 2 * h; ++dx)
+          for (int i = 0; i < n; ++i) c[i] += std::abs(pd[i + dx] - o[i]);
       }
-      for (int i = 0; i < n; ++i) out[valid0 + i] = c[i] * scale;
+      for (int i = 0; i < n; ++i) out[c0 + i] = c[i] * scale;
     }
   }
 }
@@ -238,6 +344,8 @@ bool SizeVolume(const Bands& bands, int y0, int y1, int h, CostVolume* v) {
   // a column that does not need d only costs its computation
   // (RowWinners checks each pixel's own band).
   std::vector<int> xmin(v->nd, cols), xmax(v->nd, -1);
+  v->row_first.assign(static_cast<size_t>(v->rows) * v->nd, cols);
+  v->row_end.assign(static_cast<size_t>(v->rows) * v->nd, 0);
   // Widens the hull [seen_lo, seen_hi] (empty: seen_lo > seen_hi) by the
   // band [lo, hi], calling mark(d) for each disparity it adds.
   auto widen = [](int lo, int hi, int* seen_lo, int* seen_hi, auto&& mark) {
@@ -255,17 +363,22 @@ bool SizeVolume(const Bands& bands, int y0, int y1, int h, CostVolume* v) {
   for (int y = y0; y < y1; ++y) {
     const int* lo = bands.lo.ptr<int>(y);
     const int* hi = bands.hi.ptr<int>(y);
+    int* first = &v->row_first[static_cast<size_t>(y - y0) * v->nd];
+    int* end = &v->row_end[static_cast<size_t>(y - y0) * v->nd];
     int seen_lo = 1, seen_hi = 0;
     for (int x = h; x < cols - h; ++x)
       if (lo[x] <= hi[x])
-        widen(lo[x], hi[x], &seen_lo, &seen_hi,
-              [&](int d) { xmin[d - dlo] = std::min(xmin[d - dlo], x); });
+        widen(lo[x], hi[x], &seen_lo, &seen_hi, [&](int d) { first[d - dlo] = x; });
     seen_lo = 1;
     seen_hi = 0;
     for (int x = cols - h - 1; x >= h; --x)
       if (lo[x] <= hi[x])
-        widen(lo[x], hi[x], &seen_lo, &seen_hi,
-              [&](int d) { xmax[d - dlo] = std::max(xmax[d - dlo], x); });
+        widen(lo[x], hi[x], &seen_lo, &seen_hi, [&](int d) { end[d - dlo] = x + 1; });
+    for (int i = 0; i < v->nd; ++i)
+      if (first[i] < end[i]) {
+        xmin[i] = std::min(xmin[i], first[i]);
+        xmax[i] = std::max(xmax[i], end[i] - 1);
+      }
   }
   v->x0.assign(v->nd, 0);
   v->width.assign(v->nd, 0);
@@ -476,9 +589,12 @@ void Nl1Matcher::MatchCrop(const cv::Mat& left, const cv::Mat& right, const cv::
   cv::boxFilter(left, ml, CV_32F, cv::Size(n, n));
   cv::boxFilter(right, mr, CV_32F, cv::Size(n, n));
   const bool prenormalized = options_.cost == "prenormalized";
+  const bool zero_mean_ssd = options_.cost == "zero_mean_ssd";
   cv::Mat image, right_image, a, b;
   left.convertTo(image, CV_32F);
-  if (!prenormalized) {
+  if (zero_mean_ssd) {
+    // The 8-bit images themselves.
+  } else if (!prenormalized) {
     right.convertTo(right_image, CV_32F);
   } else {
     // Each image less its mean over twice the window: a narrower mean
@@ -503,6 +619,8 @@ void Nl1Matcher::MatchCrop(const cv::Mat& left, const cv::Mat& right, const cv::
     if (!SizeVolume(bands, y0, y1, h, &v)) continue;
     if (prenormalized)
       FillPrenormalized(a, b, h, &v);
+    else if (zero_mean_ssd)
+      FillZeroMeanSsd(left, right, h, &v);
     else
       FillWindowMean(image, right_image, ml, mr, h, &v);
     for (int y = y0; y < y1; ++y) {

@@ -211,12 +211,14 @@ inline constexpr ParamSpec kNl1MinTextureDn{
     50};
 inline constexpr ParamSpec kNl1LrTolerancePx{"nl1.lr_tolerance_px",
                                              "NL1: left-right check tolerance, pixels", 0.01, 10};
-inline constexpr const char* kNl1Costs[] = {"window_mean", "prenormalized", nullptr};
+inline constexpr const char* kNl1Costs[] = {"window_mean", "prenormalized", "zero_mean_ssd",
+                                            nullptr};
 inline constexpr ParamSpec kNl1Cost{
     "nl1.cost",
     "NL1 cost: window_mean (the paper's: both windows less their own means, O(window area) per "
     "pixel and disparity) or prenormalized (each image less its mean over twice the window, "
-    "box-summed: faster, worse beside depth edges)",
+    "box-summed: faster, worse beside depth edges) or zero_mean_ssd (both windows less their own "
+    "means, squared: box-summed in exact integers, O(1) per pixel and disparity)",
     0, 0, kNl1Costs};
 inline constexpr ParamSpec kSgbmBlockSize{"sgbm.block_size",
                                           "StereoSGBM matcher: block size, pixels (odd)", 1, 21};
