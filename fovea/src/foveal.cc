@@ -372,12 +372,13 @@ FovealResult FovealStereo(const FixationFrame& matched, const Eigen::Vector3d& f
   FovealResult result;
   result.frame = matched;
   const rig::StereoFrame& frame = result.frame.views;
-  result.tessellation = Tessellate(frame.left, frame.right, fixation_W, map, options.tessellation);
+  cv::Mat map_depth;
+  map.Render(frame.left.world_T_camera, frame.left.intrinsics, &map_depth, nullptr);
+  result.tessellation =
+      TessellateFromDepth(frame.left, frame.right, fixation_W, map_depth, options.tessellation);
   Tessellation& t = result.tessellation;
   // Pixels turned in from outside the original image are not matched.
   if (result.frame.resampled) t.mask &= result.frame.left_valid;
-  cv::Mat map_depth;
-  map.Render(frame.left.world_T_camera, frame.left.intrinsics, &map_depth, nullptr);
   const int levels = static_cast<int>(t.rects.size());
   SilentCheck silent;
   if (options.silent_near_m > 0 && levels > 0) {

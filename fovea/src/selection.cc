@@ -157,13 +157,19 @@ cv::Mat LocalSuppression::Evaluate(const SelectionContext& c) const {
 }
 
 cv::Mat Proximity2D::Evaluate(const SelectionContext& c) const {
-  cv::Mat w(c.image.size(), CV_64F);
   const double cx = c.view.intrinsics.cx_px, cy = c.view.intrinsics.cy_px;
-  for (int y = 0; y < w.rows; ++y)
-    for (int x = 0; x < w.cols; ++x)
-      w.at<double>(y, x) = std::exp(-std::hypot(x - cx, y - cy) / scale_);
-  NormalizeSum(&w);
-  return w;
+  const std::lock_guard<std::mutex> lock(mutex_);
+  if (weights_.size() != c.image.size() || cx_ != cx || cy_ != cy) {
+    cv::Mat w(c.image.size(), CV_64F);
+    for (int y = 0; y < w.rows; ++y)
+      for (int x = 0; x < w.cols; ++x)
+        w.at<double>(y, x) = std::exp(-std::hypot(x - cx, y - cy) / scale_);
+    NormalizeSum(&w);
+    weights_ = w;
+    cx_ = cx;
+    cy_ = cy;
+  }
+  return weights_.clone();
 }
 
 cv::Mat Proximity3D::Evaluate(const SelectionContext& c) const {

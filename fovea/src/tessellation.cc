@@ -71,6 +71,14 @@ cv::Rect AtLeast(const cv::Rect& r, int size, double cx, double cy,
 Tessellation Tessellate(const rig::CameraView& left, const rig::CameraView& right,
                         const Eigen::Vector3d& fixation_W, const PatchMap& map,
                         const TessellationOptions& options) {
+  cv::Mat depth;
+  map.Render(left.world_T_camera, left.intrinsics, &depth, nullptr);
+  return TessellateFromDepth(left, right, fixation_W, depth, options);
+}
+
+Tessellation TessellateFromDepth(const rig::CameraView& left, const rig::CameraView& right,
+                                 const Eigen::Vector3d& fixation_W, const cv::Mat& depth,
+                                 const TessellationOptions& options) {
   Tessellation t;
   const rig::CameraIntrinsics& k = left.intrinsics;
   t.fixation_depth_m = (left.world_T_camera.inverse() * fixation_W).z();
@@ -93,8 +101,6 @@ Tessellation Tessellate(const rig::CameraView& left, const rig::CameraView& righ
   t.z_t_near_m = solve(-1, std::max(0.0, z0 - 0.05));
 
   // Z_max from the map in view, limited to Z_T; the mask from the same depths.
-  cv::Mat depth;
-  map.Render(left.world_T_camera, k, &depth, nullptr);
   t.mask = cv::Mat(k.height_px, k.width_px, CV_8U, cv::Scalar(255));
   for (int v = 0; v < k.height_px; ++v)
     for (int u = 0; u < k.width_px; ++u) {

@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 #include <memory>
+#include <mutex>
 #include <opencv2/core.hpp>
 #include <optional>
 #include <random>
@@ -134,6 +135,11 @@ class Proximity2D : public FixationCriterion {
 
  private:
   double scale_;
+  // The weights depend only on the image's size and principal point: made
+  // once (an exp and a hypot per pixel), then copied.
+  mutable std::mutex mutex_;
+  mutable cv::Mat weights_;
+  mutable double cx_ = 0, cy_ = 0;
 };
 
 /// Two levels: high where the map depth lies within the current fixation's

@@ -66,4 +66,10 @@ Tessellation Tessellate(const rig::CameraView& left, const rig::CameraView& righ
                         const Eigen::Vector3d& fixation_W, const PatchMap& map,
                         const TessellationOptions& options);
 
+/// The same from the map's depth in the left view, rendered already
+/// (PatchMap::Render: 0 where the map is silent).
+Tessellation TessellateFromDepth(const rig::CameraView& left, const rig::CameraView& right,
+                                 const Eigen::Vector3d& fixation_W, const cv::Mat& map_depth,
+                                 const TessellationOptions& options);
+
 }  // namespace fovea
