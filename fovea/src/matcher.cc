@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <opencv2/imgproc.hpp>
 #include <vector>
@@ -192,6 +193,13 @@ FOVEA_SIMD_CLONES void FillZeroMeanSsd(const cv::Mat& l, const cv::Mat& r, int h
   }
 }
 
+// Eight floats (GCC's vector extensions: one AVX2 register in the AVX2
+// clone, two SSE registers otherwise), for sums the compiler does not keep
+// in registers itself. Loaded and stored with memcpy; |v| by clearing the
+// sign bit, as std::abs does.
+typedef float Floats8 __attribute__((vector_size(32)));
+typedef int32_t Ints8 __attribute__((vector_size(32)));
+
 // The paper's cost: sum |(L - mean L) - (R - mean R)| with both means over
 // the windows being compared, which no running sum can share: O(window
 // area) per pixel and disparity. Per disparity, the strip's differences
@@ -238,19 +246,43 @@ FOVEA_SIMD_CLONES void FillWindowMean(const cv::Mat& l, const cv::Mat& r, const 
       const float* __restrict pml = ml.ptr<float>(y) + x0 + c0;
       const float* __restrict pmr = mr.ptr<float>(y) + x0 + c0 - d;
       float* __restrict o = offset.data();
-      float* __restrict c = acc.data();
-      for (int i = 0; i < n; ++i) {
-        o[i] = pml[i] - pmr[i];
-        c[i] = 0;
+      for (int i = 0; i < n; ++i) o[i] = pml[i] - pmr[i];
+      // diff's row of y - h + dy, from the column c0 - h of [x0, x0 + width).
+      const float* row0 = &diff[static_cast<size_t>(y - v->y0) * span] + (c0 - valid0);
+      // Blocks of 16 columns, their sums held in two registers of 8 floats
+      // over the whole window (GCC's vector extensions: AVX2 registers in
+      // the AVX2 clone); then the columns left, one pass per window offset.
+      // Both add the window's terms in the same order.
+      int i0 = 0;
+      for (; i0 + 16 <= n; i0 += 16) {
+        Floats8 c_lo = {}, c_hi = {}, o_lo, o_hi, l_lo, l_hi;
+        std::memcpy(&o_lo, o + i0, sizeof o_lo);
+        std::memcpy(&o_hi, o + i0 + 8, sizeof o_hi);
+        for (int dy = 0; dy <= 2 * h; ++dy) {
+          const float* pd = row0 + static_cast<size_t>(dy) * span + i0;
+          for (int dx = 0; dx <= 2 * h; ++dx) {
+            std::memcpy(&l_lo, pd + dx, sizeof l_lo);
+            std::memcpy(&l_hi, pd + dx + 8, sizeof l_hi);
+            c_lo += reinterpret_cast<Floats8>(reinterpret_cast<Ints8>(l_lo - o_lo) & 0x7fffffff);
+            c_hi += reinterpret_cast<Floats8>(reinterpret_cast<Ints8>(l_hi - o_hi) & 0x7fffffff);
+          }
+        }
+        c_lo *= scale;
+        c_hi *= scale;
+        std::memcpy(out + c0 + i0, &c_lo, sizeof c_lo);
+        std::memcpy(out + c0 + i0 + 8, &c_hi, sizeof c_hi);
       }
-      for (int dy = 0; dy <= 2 * h; ++dy) {
-        // diff's row of y - h + dy, from the column c0 - h of [x0, x0 + width).
-        const float* __restrict pd =
-            &diff[static_cast<size_t>(y - v->y0 + dy) * span] + (c0 - valid0);
-        for (int dx = 0; dx <= 2 * h; ++dx)
-          for (int i = 0; i < n; ++i) c[i] += std::abs(pd[i + dx] - o[i]);
+      if (i0 < n) {
+        float* __restrict c = acc.data();
+        const int m = n - i0;
+        std::fill(c, c + m, 0.0f);
+        for (int dy = 0; dy <= 2 * h; ++dy) {
+          const float* __restrict pd = row0 + static_cast<size_t>(dy) * span + i0;
+          for (int dx = 0; dx <= 2 * h; ++dx)
+            for (int i = 0; i < m; ++i) c[i] += std::abs(pd[i + dx] - o[i0 + i]);
+        }
+        for (int i = 0; i < m; ++i) out[c0 + i0 + i] = c[i] * scale;
       }
-      for (int i = 0; i < n; ++i) out[c0 + i] = c[i] * scale;
     }
   }
 }
