@@ -162,6 +162,7 @@ expect 2 "--set expects KEY=VALUE" fixate --point 0 0.9 0 --set foveal.rectify -
 expect 2 "--fixations (loop.fixations): 0 is out of range" run --fixations 0 --out "$t/out"
 expect 2 "--fixations (loop.fixations): expected a whole number" run --fixations 2.5 --out "$t/out"
 expect 2 "--point: expected a number" bench fixation --point 1e999 0 0
+expect 2 "key 'nl1.cost': 'census' is not one of window_mean, prenormalized, zero_mean_ssd" bench fixation --set nl1.cost=census
 expect 2 "--jobs" sweep "$in/one.yaml" --jobs -1 --out "$t/out"
 expect 2 "--square" chessboards --square nan --out "$t/out"
 expect 2 "--square" calibrate --left "$in/boards/left_*.png" --right "$in/boards/right_*.png" --board 9x6 --square 0 --out "$t/out.yaml"
