@@ -16,9 +16,7 @@ namespace {
 
 // Quantile(*v, 0.5) without the copy: reorders *v.
 double MedianInPlace(std::vector<double>* v) {
-  const auto k = static_cast<long>(std::lround(0.5 * double(v->size() - 1)));
-  std::nth_element(v->begin(), v->begin() + k, v->end());
-  return (*v)[k];
+  return fovea::NthSmallest(v, static_cast<size_t>(std::lround(0.5 * double(v->size() - 1))));
 }
 
 struct Accumulator {

@@ -57,6 +57,29 @@ struct CostVolume {
   int RowEnd(int y, int d) const { return row_end[(y - y0) * nd + d - dlo]; }
 };
 
+// The rows of a strip and their windows, per disparity d, for the
+// box-summed costs: diff[row * span + i] = op(a, b) of the left pixel at
+// column x0 - h + i and the right pixel d to its left, 0 where that right
+// pixel leaves the image (those columns are masked later). Inlined into
+// each caller, so that it is built with the caller's instruction set.
+template <typename In, typename Out, typename Op>
+inline __attribute__((always_inline)) void StripDifferences(const cv::Mat& a, const cv::Mat& b,
+                                                            const CostVolume& v, int d, int h,
+                                                            int x0, int span, Op op,
+                                                            std::vector<Out>* diff) {
+  const int first = std::clamp(d - (x0 - h), 0, span),
+            last = std::clamp(a.cols + d - (x0 - h), 0, span);
+  diff->resize(static_cast<size_t>(v.rows + 2 * h) * span);
+  for (int row = 0; row < v.rows + 2 * h; ++row) {
+    const In* __restrict pa = a.ptr<In>(v.y0 - h + row) + (x0 - h);
+    const In* __restrict pb = b.ptr<In>(v.y0 - h + row) + (x0 - h - d);
+    Out* __restrict out = &(*diff)[static_cast<size_t>(row) * span];
+    std::fill(out, out + first, Out{0});
+    for (int i = first; i < last; ++i) out[i] = op(pa[i], pb[i]);
+    std::fill(out + last, out + span, Out{0});
+  }
+}
+
 // The pre-normalized cost: each image less its local mean (a, b), then
 // the mean over the window of |a - b|, box-summed for a whole strip and
 // disparity at once: O(1) per pixel and disparity in the window's area
@@ -70,20 +93,9 @@ FOVEA_SIMD_CLONES void FillPrenormalized(const cv::Mat& a, const cv::Mat& b, int
     const int width = v->width[d - v->dlo];
     if (width <= 0) continue;
     const int x0 = v->x0[d - v->dlo], span = width + 2 * h;
-    diff.resize(static_cast<size_t>(v->rows + 2 * h) * span);
     vsum.resize(span);
-    // Columns whose right pixel x - d lies in the image; the rest are
-    // masked below and only need to be finite.
-    const int first = std::clamp(d - (x0 - h), 0, span),
-              last = std::clamp(cols + d - (x0 - h), 0, span);
-    for (int r = 0; r < v->rows + 2 * h; ++r) {
-      const float* __restrict pa = a.ptr<float>(v->y0 - h + r) + (x0 - h);
-      const float* __restrict pb = b.ptr<float>(v->y0 - h + r) + (x0 - h - d);
-      float* __restrict out = &diff[static_cast<size_t>(r) * span];
-      std::fill(out, out + first, 0.0f);
-      for (int i = first; i < last; ++i) out[i] = std::abs(pa[i] - pb[i]);
-      std::fill(out + last, out + span, 0.0f);
-    }
+    StripDifferences<float>(
+        a, b, *v, d, h, x0, span, [](float p, float q) { return std::abs(p - q); }, &diff);
     // Column sums of n diff rows, run down the strip (add the row entering
     // the window, subtract the one leaving), then n-wide row sums.
     float* __restrict vs = vsum.data();
@@ -129,23 +141,12 @@ FOVEA_SIMD_CLONES void FillZeroMeanSsd(const cv::Mat& l, const cv::Mat& r, int h
     const int width = v->width[d - v->dlo];
     if (width <= 0) continue;
     const int x0 = v->x0[d - v->dlo], span = width + 2 * h;
-    diff.resize(static_cast<size_t>(v->rows + 2 * h) * span);
     s1.assign(span, 0);
     s2.assign(span, 0);
     w1.resize(width);
     w2.resize(width);
-    // Columns whose right pixel x - d lies in the image; the rest are
-    // masked below and only need to be finite.
-    const int first = std::clamp(d - (x0 - h), 0, span),
-              last = std::clamp(cols + d - (x0 - h), 0, span);
-    for (int row = 0; row < v->rows + 2 * h; ++row) {
-      const uchar* __restrict pa = l.ptr<uchar>(v->y0 - h + row) + (x0 - h);
-      const uchar* __restrict pb = r.ptr<uchar>(v->y0 - h + row) + (x0 - h - d);
-      int32_t* __restrict out = &diff[static_cast<size_t>(row) * span];
-      std::fill(out, out + first, 0);
-      for (int i = first; i < last; ++i) out[i] = int32_t{pa[i]} - int32_t{pb[i]};
-      std::fill(out + last, out + span, 0);
-    }
+    StripDifferences<uchar>(
+        l, r, *v, d, h, x0, span, [](uchar p, uchar q) { return int32_t{p} - int32_t{q}; }, &diff);
     int32_t* __restrict c1 = s1.data();
     int32_t* __restrict c2 = s2.data();
     for (int k = 0; k < n - 1; ++k) {

@@ -8,6 +8,7 @@
 
 #include "fovea/geometry.h"
 #include "fovea/params.h"
+#include "fovea/stats.h"
 
 namespace fovea {
 
@@ -63,8 +64,7 @@ cv::Mat GradientAttraction::Evaluate(const SelectionContext& c) const {
   // alike, so that the strong contrast of an occluding edge does not hold
   // the eye on the edge fixation after fixation.
   std::vector<double> v(g.begin<double>(), g.end<double>());
-  std::nth_element(v.begin(), v.begin() + v.size() * 8 / 10, v.end());
-  const double cap = v[v.size() * 8 / 10];
+  const double cap = NthSmallest(&v, v.size() * 8 / 10);
   if (cap > 0) cv::min(g, cap, g);
   NormalizeSum(&g);
   return g;
