@@ -47,9 +47,16 @@ void SetDepthSigma(Patch* patch, const rig::CameraView& left, const Eigen::Vecto
 }
 
 bool PatchMap::SameSurface(double za, const Patch& a, double zb, const Patch& b) {
-  const double band = std::max(kSameSurfaceShare * std::min(za, zb),
-                               kSameSurfaceSigmas * std::hypot(a.sigma_z_m, b.sigma_z_m));
-  return std::abs(za - zb) <= band;
+  // |za - zb| <= max(share min(za, zb), sigmas hypot(sigma_a, sigma_b)),
+  // decided without the hypot (slow, and Render asks per pixel drawn over
+  // another) where its bounds max(|sa|, |sb|) <= hypot <= |sa| + |sb|
+  // settle it with a margin for rounding; the same answer everywhere.
+  const double diff = std::abs(za - zb);
+  if (diff <= kSameSurfaceShare * std::min(za, zb)) return true;
+  const double sa = std::abs(a.sigma_z_m), sb = std::abs(b.sigma_z_m);
+  if (diff > kSameSurfaceSigmas * (sa + sb) * (1 + 1e-12)) return false;
+  if (diff < kSameSurfaceSigmas * std::max(sa, sb) * (1 - 1e-12)) return true;
+  return diff <= kSameSurfaceSigmas * std::hypot(a.sigma_z_m, b.sigma_z_m);
 }
 
 void PlaneFitOptions::Check(const rig::ParamSpec& min_support_spec,

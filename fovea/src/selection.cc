@@ -12,6 +12,32 @@
 
 namespace fovea {
 
+namespace {
+
+// Each pixel the map is silent at takes the depth of the nearest one it
+// shows (SelectionContext::Make with fill_holes).
+void FillHoles(SelectionContext* context) {
+  SelectionContext& c = *context;
+  const cv::Mat holes = c.map_depth_m <= 0;
+  const int n_holes = cv::countNonZero(holes);
+  if (n_holes == 0 || n_holes == static_cast<int>(holes.total())) return;
+  // Each hole pixel gets the label of its nearest mapped (zero) pixel.
+  cv::Mat distance, labels;
+  cv::distanceTransform(holes, distance, labels, cv::DIST_L2, cv::DIST_MASK_5,
+                        cv::DIST_LABEL_PIXEL);
+  std::vector<float> depth_of_label(holes.total() + 1, 0.f);
+  for (int y = 0; y < holes.rows; ++y)
+    for (int x = 0; x < holes.cols; ++x)
+      if (!holes.at<uchar>(y, x))
+        depth_of_label[labels.at<int>(y, x)] = c.map_depth_m.at<float>(y, x);
+  for (int y = 0; y < holes.rows; ++y)
+    for (int x = 0; x < holes.cols; ++x)
+      if (holes.at<uchar>(y, x))
+        c.map_depth_m.at<float>(y, x) = depth_of_label[labels.at<int>(y, x)];
+}
+
+}  // namespace
+
 SelectionContext SelectionContext::Make(const cv::Mat& image, const rig::CameraView& view,
                                         const PatchMap& map, bool fill_holes) {
   SelectionContext c;
@@ -26,23 +52,15 @@ SelectionContext SelectionContext::Make(const cv::Mat& image, const rig::CameraV
       const int id = ids.at<int>(y, x);
       if (id >= 0) c.map_level.at<signed char>(y, x) = static_cast<signed char>(map[id].level);
     }
-  if (!fill_holes) return c;
-  const cv::Mat holes = c.map_depth_m <= 0;
-  const int n_holes = cv::countNonZero(holes);
-  if (n_holes == 0 || n_holes == static_cast<int>(holes.total())) return c;
-  // Each hole pixel gets the label of its nearest mapped (zero) pixel.
-  cv::Mat distance, labels;
-  cv::distanceTransform(holes, distance, labels, cv::DIST_L2, cv::DIST_MASK_5,
-                        cv::DIST_LABEL_PIXEL);
-  std::vector<float> depth_of_label(holes.total() + 1, 0.f);
-  for (int y = 0; y < holes.rows; ++y)
-    for (int x = 0; x < holes.cols; ++x)
-      if (!holes.at<uchar>(y, x))
-        depth_of_label[labels.at<int>(y, x)] = c.map_depth_m.at<float>(y, x);
-  for (int y = 0; y < holes.rows; ++y)
-    for (int x = 0; x < holes.cols; ++x)
-      if (holes.at<uchar>(y, x))
-        c.map_depth_m.at<float>(y, x) = depth_of_label[labels.at<int>(y, x)];
+  if (fill_holes) FillHoles(&c);
+  cv::Mat points(c.map_depth_m.size(), CV_64FC3, cv::Scalar::all(0));
+  for (int y = 0; y < c.map_depth_m.rows; ++y)
+    for (int x = 0; x < c.map_depth_m.cols; ++x)
+      if (c.map_depth_m.at<float>(y, x) > 0) {
+        const Eigen::Vector3d p = c.MapPoint(x, y);  // computed: no cache yet
+        points.at<cv::Vec3d>(y, x) = cv::Vec3d(p.x(), p.y(), p.z());
+      }
+  c.map_points_W = points;
   return c;
 }
 
@@ -71,6 +89,10 @@ cv::Mat GradientAttraction::Evaluate(const SelectionContext& c) const {
 }
 
 Eigen::Vector3d SelectionContext::MapPoint(int x, int y) const {
+  if (!map_points_W.empty()) {
+    const cv::Vec3d& p = map_points_W.at<cv::Vec3d>(y, x);
+    return {p[0], p[1], p[2]};
+  }
   return view.world_T_camera *
          (map_depth_m.at<float>(y, x) * view.intrinsics.Ray({double(x), double(y)}));
 }
@@ -104,18 +126,24 @@ cv::Rect PixelsNear(const rig::CameraView& view, const Eigen::Vector3d& p_W, dou
 }
 
 // Calls visit(x, y, r) for each pixel that PixelsNear(p_W, radius) gives,
-// whose map point lies within `radius` of p_W (r its distance): the pixels
-// one point can reach, so that the cost does not grow with the points.
-template <typename Visit>
+// whose map point lies within `radius` of p_W (r its distance), unless
+// done(x, y) says the pixel cannot change any more: the pixels one point can
+// reach. O(box area) per point, so the cost grows with the points.
+template <typename Visit, typename Done>
 void ForPixelsNear(const SelectionContext& c, const Eigen::Vector3d& p_W, double radius,
-                   Visit visit) {
+                   Visit visit, Done done) {
   const cv::Rect box = PixelsNear(c.view, p_W, radius);
   for (int y = box.y; y < box.y + box.height; ++y)
     for (int x = box.x; x < box.x + box.width; ++x) {
-      if (!(c.map_depth_m.at<float>(y, x) > 0)) continue;
+      if (!(c.map_depth_m.at<float>(y, x) > 0) || done(x, y)) continue;
       const double r = (c.MapPoint(x, y) - p_W).norm();
       if (r < radius) visit(x, y, r);
     }
+}
+template <typename Visit>
+void ForPixelsNear(const SelectionContext& c, const Eigen::Vector3d& p_W, double radius,
+                   Visit visit) {
+  ForPixelsNear(c, p_W, radius, visit, [](int, int) { return false; });
 }
 
 }  // namespace
@@ -145,13 +173,17 @@ cv::Mat LocalSuppression::Evaluate(const SelectionContext& c) const {
   // order of the points does not matter).
   const double reach = std::max(radius_, revisit_);
   for (const Eigen::Vector3d& f : points)
-    ForPixelsNear(c, f, reach, [&](int x, int y, double r) {
-      double& wp = w.at<double>(y, x);
-      if (r < revisit_)
-        wp = 0;
-      else if (r < radius_)
-        wp = std::min(wp, low_);
-    });
+    ForPixelsNear(
+        c, f, reach,
+        [&](int x, int y, double r) {
+          double& wp = w.at<double>(y, x);
+          if (r < revisit_)
+            wp = 0;
+          else if (r < radius_)
+            wp = std::min(wp, low_);
+        },
+        // 0 stays 0 (the weights are not negative).
+        [&](int x, int y) { return w.at<double>(y, x) == 0; });
   NormalizeSum(&w);
   return w;
 }

@@ -47,6 +47,11 @@ struct SelectionContext {
   /// run maps) are candidates.
   std::optional<rig::CameraView> region;
 
+  /// MapPoint at every pixel with map_depth_m > 0 (CV_64FC3, world
+  /// frame), made once by Make: local suppression and the refused points
+  /// visit a box of pixels about each earlier point, every attempt.
+  cv::Mat map_points_W;
+
   /// The map point seen at a pixel (requires map_depth_m > 0 there).
   Eigen::Vector3d MapPoint(int x, int y) const;
 
