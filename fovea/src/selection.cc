@@ -14,6 +14,12 @@ namespace fovea {
 
 namespace {
 
+// The map point at a pixel, from the view and the map's depth there.
+Eigen::Vector3d PointAt(const SelectionContext& c, int x, int y) {
+  return c.view.world_T_camera *
+         (c.map_depth_m.at<float>(y, x) * c.view.intrinsics.Ray({double(x), double(y)}));
+}
+
 // Each pixel the map is silent at takes the depth of the nearest one it
 // shows (SelectionContext::Make with fill_holes).
 void FillHoles(SelectionContext* context) {
@@ -57,7 +63,7 @@ SelectionContext SelectionContext::Make(const cv::Mat& image, const rig::CameraV
   for (int y = 0; y < c.map_depth_m.rows; ++y)
     for (int x = 0; x < c.map_depth_m.cols; ++x)
       if (c.map_depth_m.at<float>(y, x) > 0) {
-        const Eigen::Vector3d p = c.MapPoint(x, y);  // computed: no cache yet
+        const Eigen::Vector3d p = PointAt(c, x, y);
         points.at<cv::Vec3d>(y, x) = cv::Vec3d(p.x(), p.y(), p.z());
       }
   c.map_points_W = points;
@@ -93,8 +99,7 @@ Eigen::Vector3d SelectionContext::MapPoint(int x, int y) const {
     const cv::Vec3d& p = map_points_W.at<cv::Vec3d>(y, x);
     return {p[0], p[1], p[2]};
   }
-  return view.world_T_camera *
-         (map_depth_m.at<float>(y, x) * view.intrinsics.Ray({double(x), double(y)}));
+  return PointAt(*this, x, y);
 }
 
 namespace {

@@ -48,14 +48,19 @@ inline double NthSmallest(std::vector<double>* v, size_t k) {
   return a[k];
 }
 
+/// Quantile (below) of a non-empty *v without a copy: *v may be reordered.
+inline double QuantileInPlace(std::vector<double>* v, double q) {
+  const auto k =
+      std::min(v->size() - 1, static_cast<size_t>(std::lround(q * double(v->size() - 1))));
+  return NthSmallest(v, k);
+}
+
 /// The q-quantile of `v` (0 <= q <= 1): its element of rank round(q (n - 1))
 /// in sorted order, so q = 0 is the smallest, q = 1 the largest and q = 0.5
 /// the median (the upper one for even n); `if_empty` when there are no
 /// values.
 inline double Quantile(std::vector<double> v, double q, double if_empty = 0) {
-  if (v.empty()) return if_empty;
-  const auto k = std::min(v.size() - 1, static_cast<size_t>(std::lround(q * double(v.size() - 1))));
-  return NthSmallest(&v, k);
+  return v.empty() ? if_empty : QuantileInPlace(&v, q);
 }
 
 }  // namespace fovea
