@@ -110,7 +110,8 @@ TEST_CASE(
   CHECK(s["motion_time_s"].get<double>() > records_motion_s);
   CHECK(s["wall_time_s"].get<double>() > s["compute_time_s"].get<double>());
   std::vector<std::string> files = {run_folder::kMapPly, run_folder::kFixationPath,
-                                    run_folder::kConfig, run_folder::kReference};
+                                    run_folder::kConfig, run_folder::kReference,
+                                    run_folder::kErrorPicture};
   for (const int k : run_folder::kSnapshotFixations) files.push_back(run_folder::SnapshotName(k));
   for (const std::string& f : files) {
     INFO(f);

@@ -98,6 +98,51 @@ TEST_CASE("where the map is silent, a surface outside Z_T gives no false patches
   CHECK(ours_checked.second >= ours.second - ours.first);  // the right patches stay
 }
 
+TEST_CASE("peripheral blocks are not split below the matching window beside depth edges",
+          "[foveal][slow]") {
+  // A fixation on the near wooden block's face: its edges against the
+  // plywood 0.65 m behind cross the periphery.
+  sim::SimRigConfig config;
+  config.noise.read_noise_sigma_dn = experiments::kExperimentNoiseSigmaDn;
+  struct Figures {
+    int patches = 0, gross = 0, least_support = 1 << 30;
+  };
+  auto fixate = [&](int periphery_min_block_px) {
+    auto sim = scenes::LoadScene("three_surfaces", config);
+    const fovea::IdrResult idr = fovea::RunIdr(sim->rig(), {});
+    fovea::FixationOptions o = fovea::ResolvedFixationOptions({});  // the run's
+    o.foveal.periphery_min_block_px = periphery_min_block_px;
+    const fovea::Nl1Matcher matcher;
+    const fovea::FixationResult r =
+        fovea::Fixate(sim->rig(), idr.map, {0.09, 0.86, 0.05}, matcher, o);
+    REQUIRE(r.ok);
+    Figures f;
+    for (const fovea::Patch& p : r.foveal.patches.patches())
+      if (p.resolution_level > 0) {
+        ++f.patches;
+        f.least_support = std::min(f.least_support, p.support);
+      }
+    const experiments::FovealScore s = experiments::ScoreFoveal(r, sim->truth());
+    for (size_t k = 1; k < s.levels.size(); ++k) f.gross += s.levels[k].gross_errors;
+    return f;
+  };
+  const Figures whole = fixate(16), split = fixate(4);
+  INFO("peripheral patches: whole blocks "
+       << whole.patches << " (" << whole.gross << " off by over 5%, least support "
+       << whole.least_support << "), split to 4 px " << split.patches << " (" << split.gross << ", "
+       << split.least_support << ")");
+  REQUIRE(whole.patches > 0);
+  // The default's 16-pixel blocks are whole: half their pixels are inliers.
+  CHECK(whole.least_support >= 128);
+  // Split to 4 pixels, the edges' quarters (16 pixels at most) become patches.
+  CHECK(split.patches > whole.patches);
+  CHECK(split.least_support < 128);
+  // Those quarters are where the wrong depth was (measured: 53 of 306
+  // patches off by over 5% split, 0 of 99 whole).
+  CHECK(split.gross >= 10);
+  CHECK(whole.gross * 5 <= split.gross);
+}
+
 namespace {
 
 // A photo-textured plane facing the rig's centre from `distance_m` at

@@ -87,3 +87,45 @@ TEST_CASE("map score: the pixels near edges are split by the source of the patch
   CHECK(pixels == edge_pixels);
   CHECK(bad == Approx(edge_pixels * j["edge_bad_share"].get<double>()).epsilon(1e-9));
 }
+
+TEST_CASE("error picture: right pixels green, too near red, too far magenta, true edges blue",
+          "[experiments][scoring]") {
+  // A synthetic reference view: a wall at 1 m over the left half, a block at
+  // 0.5 m over the right half, every pixel textured.
+  experiments::ReferenceView ref;
+  const rig::CameraIntrinsics k = rig::CameraIntrinsics::FromHorizontalFov(64, 48, 1.0);
+  ref.view.intrinsics = k;
+  ref.view.gray = cv::Mat(48, 64, CV_8U, cv::Scalar(100));
+  ref.depth_m = cv::Mat(48, 64, CV_32F, cv::Scalar(1.0f));
+  ref.depth_m.colRange(32, 64).setTo(0.5f);
+  ref.textured = cv::Mat(48, 64, CV_8U, cv::Scalar(255));
+  ref.textured.rowRange(40, 48).setTo(0);  // not scored: left grey
+  // Fronto-parallel quads over columns [u0, u1) and rows [v0, v1) at depth z.
+  auto quad = [&](double u0, double u1, double v0, double v1, double z) {
+    fovea::Patch p;
+    const double us[4] = {u0, u1, u1, u0}, vs[4] = {v0, v0, v1, v1};
+    for (int c = 0; c < 4; ++c)
+      p.corners_W[c] =
+          Eigen::Vector3d((us[c] - k.cx_px) / k.fx_px * z, (vs[c] - k.cy_px) / k.fy_px * z, z);
+    return p;
+  };
+  fovea::PatchMap map;
+  map.Add(quad(-0.5, 31.5, -0.5, 47.5, 1.003));  // the wall, 0.3% off: right
+  map.Add(quad(31.5, 63.5, -0.5, 15.5, 0.45));   // the block's top, 10% too near
+  map.Add(quad(31.5, 63.5, 15.5, 47.5, 0.53));   // the rest, 6% too far
+  const cv::Mat pic = experiments::ErrorPicture(map, ref);
+  REQUIRE(pic.size() == ref.depth_m.size());
+  REQUIRE(pic.type() == CV_8UC3);
+  auto at = [&](int x, int y) { return pic.at<cv::Vec3b>(y, x); };  // B, G, R
+  const cv::Vec3b right = at(10, 10), near = at(50, 5), far = at(50, 30), grey = at(10, 44);
+  CHECK(right[1] > 150);
+  CHECK(right[1] > right[0] + 100);
+  CHECK(right[1] > right[2] + 100);
+  CHECK(near == cv::Vec3b(16, 16, 255));  // saturated: more than 5% off
+  CHECK(far == cv::Vec3b(255, 16, 255));
+  CHECK(grey == cv::Vec3b(50, 50, 50));  // mapped, but not scored
+  // Both sides of the true jump between columns 31 and 32 are drawn.
+  CHECK(at(31, 20) == cv::Vec3b(255, 80, 0));
+  CHECK(at(32, 20) == cv::Vec3b(255, 80, 0));
+  CHECK(at(30, 20) == right);
+}

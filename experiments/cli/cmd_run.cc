@@ -81,6 +81,7 @@ int RunStatic(const RunConfig& config, OutputFolder& folder, Clock::time_point t
                 ScoreLine(score, true).c_str());
   WriteImageAtomic(dir + "/" + rf::kMapPicture, MapSnapshot(r.map, ref, centre, caption));
   WriteImageAtomic(dir + "/" + rf::kReference, ref.view.gray);
+  WriteImageAtomic(dir + "/" + rf::kErrorPicture, ErrorPicture(r.map, ref));
   WriteTextAtomic(dir + "/" + rf::kMapPly, PatchMapPly(r.map));
   WriteTextAtomic(dir + "/" + rf::kRecords, "");
   nlohmann::json summary =
@@ -236,6 +237,7 @@ int Run(const RunArgs& args) {
   WriteImageAtomic(dir + "/" + rf::kFixationPath,
                    FixationPath(ref, recorder.path(), recorder.refused()));
   WriteImageAtomic(dir + "/" + rf::kReference, ref.view.gray);
+  WriteImageAtomic(dir + "/" + rf::kErrorPicture, ErrorPicture(run.map, ref));
   recorder.output_s += Since(t);
   const double wall = Since(t_wall);
   nlohmann::json summary =

@@ -281,6 +281,7 @@ void AddFovealParams(RunConfig* c, std::vector<ConfigParam>* params) {
                      {&fp::kFovealEdgeJumpPx, &x.foveal.edge_jump_px},
                      {&fp::kFovealMinFillShare, &x.foveal.blocks.min_fill_share},
                      {&fp::kFovealMinBlockPx, &x.foveal.blocks.min_block_px},
+                     {&fp::kFovealPeripheryMinBlockPx, &x.foveal.periphery_min_block_px},
                      {&fp::kFovealClipToInliers, &x.foveal.blocks.clip_to_inliers},
                      {&fp::kFovealRectify, &x.foveal.rectify},
                      {&fp::kFovealFitMinSupport, &x.foveal.plane_fit.min_support},

@@ -164,7 +164,10 @@ std::string RunPictures(const std::string& dir) {
     if (fs::exists(name)) h += Img(name, "the map after fixation " + std::to_string(k));
   }
   const std::pair<const char*, const char*> more[] = {
-      {run_folder::kMapPicture, "the map"}, {run_folder::kFixationPath, "the fixation path"}};
+      {run_folder::kMapPicture, "the map"},
+      {run_folder::kFixationPath, "the fixation path"},
+      {run_folder::kErrorPicture,
+       "where the map is right (green), too near (red) and too far (magenta)"}};
   for (const auto& [file, alt] : more)
     if (fs::exists(dir + "/" + file)) h += Img(dir + "/" + file, alt);
   return h;

@@ -64,9 +64,9 @@ bool RightCameraSees(const rig::RigGeometry& geometry, const std::vector<double>
   return false;
 }
 
-// Pixels within kEdgeRadiusPx of a jump of more than kEdgeJumpM in the true
+// The pixels on either side of a jump of more than kEdgeJumpM in the true
 // depth (nothing counts as infinitely far).
-cv::Mat NearEdge(const cv::Mat& depth_m) {
+cv::Mat DepthEdges(const cv::Mat& depth_m) {
   cv::Mat edge = cv::Mat::zeros(depth_m.size(), CV_8U);
   auto z = [&](int y, int x) {
     const float d = depth_m.at<float>(y, x);
@@ -84,9 +84,14 @@ cv::Mat NearEdge(const cv::Mat& depth_m) {
           edge.at<uchar>(y + 1, x) = 255;
       }
     }
+  return edge;
+}
+
+// Pixels within kEdgeRadiusPx of a DepthEdges pixel.
+cv::Mat NearEdge(const cv::Mat& depth_m) {
   cv::Mat near;
   cv::dilate(
-      edge, near,
+      DepthEdges(depth_m), near,
       cv::getStructuringElement(cv::MORPH_RECT, {2 * kEdgeRadiusPx + 1, 2 * kEdgeRadiusPx + 1}));
   return near;
 }
@@ -309,6 +314,33 @@ MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref,
   }
   if (per_patch) ScorePatches(map, ref.view, truth, &s);
   return s;
+}
+
+cv::Mat ErrorPicture(const fovea::PatchMap& map, const ReferenceView& ref) {
+  cv::Mat depth;
+  map.Render(ref.view.world_T_camera, ref.view.intrinsics, &depth, nullptr);
+  const cv::Mat edges = DepthEdges(ref.depth_m);
+  cv::Mat out(ref.view.gray.size(), CV_8UC3);
+  constexpr double kFullRed = 0.05;  // relative error shown at full brightness
+  for (int y = 0; y < out.rows; ++y)
+    for (int x = 0; x < out.cols; ++x) {
+      const int g = ref.view.gray.at<uchar>(y, x) / 2;
+      cv::Vec3b& o = out.at<cv::Vec3b>(y, x);
+      o = {uchar(g), uchar(g), uchar(g)};
+      const double z = depth.at<float>(y, x), zt = ref.depth_m.at<float>(y, x);
+      if (ref.textured.at<uchar>(y, x) && z > 0 && zt > 0) {
+        const double rel = std::abs(z - zt) / zt;
+        if (rel <= kBadShare) {
+          o = {uchar(g / 2), uchar(160 + g / 2), uchar(g / 2)};
+        } else {
+          const double t = std::min(1.0, (rel - kBadShare) / (kFullRed - kBadShare));
+          const uchar v = uchar(140 + 115 * t);
+          o = z < zt ? cv::Vec3b(uchar(g / 3), uchar(g / 3), v) : cv::Vec3b(v, uchar(g / 3), v);
+        }
+      }
+      if (edges.at<uchar>(y, x)) o = {255, 80, 0};
+    }
+  return out;
 }
 
 namespace {

@@ -25,6 +25,7 @@ void FovealOptions::Check() const {
   rig::CheckParam(params::kFovealEdgeJumpPx, edge_jump_px);
   rig::CheckParam(params::kFovealMinFillShare, blocks.min_fill_share);
   rig::CheckParam(params::kFovealMinBlockPx, blocks.min_block_px);
+  rig::CheckParam(params::kFovealPeripheryMinBlockPx, periphery_min_block_px);
   plane_fit.Check(params::kFovealFitMinSupport, params::kFovealFitTolerancePx,
                   params::kFovealFitMinInlierShare);
   // Set from idr.z_min_m (ResolvedFixationOptions), not a parameter of its own.
@@ -339,8 +340,11 @@ int LevelPatches(const rig::StereoFrame& frame, const Tessellation& t, const Lev
                            static_cast<int>((by + 0.5 * block) * level.scale - 0.5));
     return level.rect.contains(centre) && !(level.index > 0 && inner.contains(centre));
   };
+  BlockOptions blocks = options.blocks;
+  if (level.index > 0)
+    blocks.min_block_px = std::max(blocks.min_block_px, options.periphery_min_block_px);
   int added = 0;
-  for (const BlockFit& b : FitBlocks(disparity, size, fit_options, options.blocks, in_level))
+  for (const BlockFit& b : FitBlocks(disparity, size, fit_options, blocks, in_level))
     if (const auto p = BlockPatch(frame, level, b, fixation)) {
       patches->Add(*p);
       ++added;

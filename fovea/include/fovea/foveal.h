@@ -57,6 +57,12 @@ struct FovealOptions {
   /// strip without data (BlockOptions; min_fill_share = 0 and
   /// clip_to_inliers = false: the paper's whole blocks).
   BlockOptions blocks;
+  /// Beyond the paper: at the peripheral levels (index > 0) blocks are split
+  /// no smaller than this, level pixels (and no smaller than
+  /// blocks.min_block_px): a quarter smaller than the matching window rests
+  /// on matches whose windows overlap, and beside an edge on windows that
+  /// straddle it. 16 with 32-pixel peripheral patches: never split.
+  int periphery_min_block_px = 16;
   /// Beyond the paper (issue 20): tessellate, match and triangulate in the
   /// pair's fixation frame (ToFixationFrame: both cameras turned virtually
   /// so that the rows of a tilted verged pair no longer twist against each

@@ -178,6 +178,14 @@ inline constexpr ParamSpec kFovealMinFillShare{
     0, 1};
 inline constexpr ParamSpec kFovealMinBlockPx{
     "foveal.min_block_px", "the smallest quarter a block is split into, level pixels", 2, 64};
+inline constexpr ParamSpec kFovealPeripheryMinBlockPx{
+    "foveal.periphery_min_block_px",
+    "beyond the paper: the smallest quarter a peripheral level's block is split into, level pixels "
+    "(at least foveal.min_block_px; at or above the peripheral block size, 16 with the default "
+    "foveal.periphery_patch_px, peripheral blocks are never split: a quarter smaller than the "
+    "matching window rests on matches whose windows overlap, and beside a depth edge on windows "
+    "that straddle it)",
+    2, 64};
 inline constexpr ParamSpec kFovealClipToInliers{
     "foveal.clip_to_inliers",
     "beyond the paper: a block's patch covers only its inliers' bounding box, not the whole "

@@ -21,6 +21,8 @@ inline constexpr char kMapPly[] = "map.ply";           ///< the patch map as qua
 inline constexpr char kMapPicture[] = "map.png";       ///< static baseline: its map
 inline constexpr char kFixationPath[] = "fixation_path.png";
 inline constexpr char kReference[] = "reference.png";  ///< the reference view
+/// The final map's error in the reference view (ErrorPicture).
+inline constexpr char kErrorPicture[] = "error.png";
 inline constexpr char kReport[] = "report.html";
 
 /// The fixations after which the map is pictured, as in the paper's

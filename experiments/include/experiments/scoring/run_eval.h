@@ -115,6 +115,14 @@ inline constexpr double kStaleCoveredShare = 0.9;
 /// cover (MapScore::stale_idr_patches).
 int StaleIdrPatches(const fovea::PatchMap& map, const rig::CameraView& view);
 
+/// Where `map` is right and wrong in the reference view (BGR, the view's
+/// size): the reference image dimmed; the mapped textured pixels (those the
+/// score counts) green within kBadShare of the true depth; beyond it, red
+/// where the map is nearer than the truth and magenta where it is farther
+/// (brighter the larger the error, full at 5%); the true depth
+/// discontinuities (either side of each jump) blue.
+cv::Mat ErrorPicture(const fovea::PatchMap& map, const ReferenceView& ref);
+
 /// Scores `map` in the reference view; `baseline_m` sets the disparity step.
 MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref,
                   const sim::GroundTruth& truth, double baseline_m, bool per_patch);
