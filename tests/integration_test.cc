@@ -248,27 +248,38 @@ TEST_CASE("a patch mostly outside the view is not replaced by what covers its sl
 TEST_CASE("IDR patches are retired where finer patches of several fixations cover them",
           "[fovea][integration]") {
   const rig::CameraView view = View();
-  fovea::PatchMap map = Grid(10, 0.5, 1.0, fovea::PatchLevel::kIdr);  // 10 cm cells
-  auto square = [](double x0, double z0, double w, double h) {
+  fovea::PatchMap map = Grid(10, 0.5, 1.0, fovea::PatchLevel::kIdr);  // 10 cm cells at 1 m
+  // A peripheral patch at depth y whose footprint in the view is the
+  // square [x0, x0 + w] x [z0, z0 + h] of the plane at 1 m.
+  auto square = [](double x0, double z0, double w, double h, double y = 1.0) {
     fovea::Patch p;
     p.corners_W = {Eigen::Vector3d(x0, 1.0, z0), Eigen::Vector3d(x0 + w, 1.0, z0),
                    Eigen::Vector3d(x0 + w, 1.0, z0 + h), Eigen::Vector3d(x0, 1.0, z0 + h)};
+    for (auto& c : p.corners_W) c *= y;
     p.level = fovea::PatchLevel::kPeripheral;
     p.resolution_level = 1;
     return p;
   };
   // IDR cell 55 spans x, z in [0, 0.1]: covered by two halves (two fixations'
-  // patches); cell 45 (x in [-0.1, 0]) only on its left half.
+  // patches); cell 45 (x in [-0.1, 0]) only on its left half. Cell 65 (x in
+  // [0.1, 0.2]) has a whole patch behind it, at 1.6 m: the farther surface
+  // seen past its edge, which does not cover it; cell 75 (x in [0.2, 0.3])
+  // one in front of it, at 0.8 m, which does.
   map.Add(square(0.0, 0.0, 0.1, 0.05));
   map.Add(square(0.0, 0.05, 0.1, 0.05));
   map.Add(square(-0.1, 0.0, 0.05, 0.1));
+  map.Add(square(0.1, 0.0, 0.1, 0.1, 1.6));
+  map.Add(square(0.2, 0.0, 0.1, 0.1, 0.8));
   const std::vector<char> covered = fovea::CoveredIdrPatches(map, view, 0.9);
   REQUIRE(covered.size() == map.size());
-  CHECK(std::count(covered.begin(), covered.end(), 1) == 1);
+  CHECK(std::count(covered.begin(), covered.end(), 1) == 2);
   CHECK(covered[55] == 1);
+  CHECK(covered[65] == 0);
+  CHECK(covered[75] == 1);
   const std::vector<char> half = fovea::CoveredIdrPatches(map, view, 0.4);
-  CHECK(std::count(half.begin(), half.end(), 1) == 2);
+  CHECK(std::count(half.begin(), half.end(), 1) == 3);
   CHECK(half[45] == 1);
+  CHECK(half[65] == 0);
   CHECK(std::count(half.begin() + 100, half.end(), 1) == 0);  // finer patches never
   // Without finer patches nothing is covered.
   const std::vector<char> none =

@@ -98,6 +98,7 @@ TEST_CASE("error picture: right pixels green, too near red, too far magenta, tru
   ref.view.gray = cv::Mat(48, 64, CV_8U, cv::Scalar(100));
   ref.depth_m = cv::Mat(48, 64, CV_32F, cv::Scalar(1.0f));
   ref.depth_m.colRange(32, 64).setTo(0.5f);
+  ref.depth_edges = experiments::DepthEdges(ref.depth_m);
   ref.textured = cv::Mat(48, 64, CV_8U, cv::Scalar(255));
   ref.textured.rowRange(40, 48).setTo(0);  // not scored: left grey
   // Fronto-parallel quads over columns [u0, u1) and rows [v0, v1) at depth z.

@@ -64,8 +64,8 @@ bool RightCameraSees(const rig::RigGeometry& geometry, const std::vector<double>
   return false;
 }
 
-// The pixels on either side of a jump of more than kEdgeJumpM in the true
-// depth (nothing counts as infinitely far).
+}  // namespace
+
 cv::Mat DepthEdges(const cv::Mat& depth_m) {
   cv::Mat edge = cv::Mat::zeros(depth_m.size(), CV_8U);
   auto z = [&](int y, int x) {
@@ -87,11 +87,13 @@ cv::Mat DepthEdges(const cv::Mat& depth_m) {
   return edge;
 }
 
-// Pixels within kEdgeRadiusPx of a DepthEdges pixel.
-cv::Mat NearEdge(const cv::Mat& depth_m) {
+namespace {
+
+// Pixels within kEdgeRadiusPx of an edge pixel.
+cv::Mat NearEdge(const cv::Mat& edges) {
   cv::Mat near;
   cv::dilate(
-      DepthEdges(depth_m), near,
+      edges, near,
       cv::getStructuringElement(cv::MORPH_RECT, {2 * kEdgeRadiusPx + 1, 2 * kEdgeRadiusPx + 1}));
   return near;
 }
@@ -143,7 +145,8 @@ ReferenceView MakeReferenceView(rig::Rig& rig, sim::Simulation& sim) {
   ref.geom_ids = labels.geom_ids;
   ref.textured = truth.TexturedMask(ref.geom_ids);
   ref.textured_pixels = cv::countNonZero(ref.textured);
-  ref.near_edge = NearEdge(ref.depth_m);
+  ref.depth_edges = DepthEdges(ref.depth_m);
+  ref.near_edge = NearEdge(ref.depth_edges);
 
   const rig::AxisLimit& travel = rig.Limits()[rig::Axis::kRightBaseline];
   std::vector<double> carriages;
@@ -319,7 +322,6 @@ MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref,
 cv::Mat ErrorPicture(const fovea::PatchMap& map, const ReferenceView& ref) {
   cv::Mat depth;
   map.Render(ref.view.world_T_camera, ref.view.intrinsics, &depth, nullptr);
-  const cv::Mat edges = DepthEdges(ref.depth_m);
   cv::Mat out(ref.view.gray.size(), CV_8UC3);
   constexpr double kFullRed = 0.05;  // relative error shown at full brightness
   for (int y = 0; y < out.rows; ++y)
@@ -338,7 +340,7 @@ cv::Mat ErrorPicture(const fovea::PatchMap& map, const ReferenceView& ref) {
           o = z < zt ? cv::Vec3b(uchar(g / 3), uchar(g / 3), v) : cv::Vec3b(v, uchar(g / 3), v);
         }
       }
-      if (edges.at<uchar>(y, x)) o = {255, 80, 0};
+      if (!ref.depth_edges.empty() && ref.depth_edges.at<uchar>(y, x)) o = {255, 80, 0};
     }
   return out;
 }

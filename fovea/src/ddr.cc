@@ -152,9 +152,17 @@ void Absorb(const FixationResult& r, const rig::CameraView& idr_view,
   const auto t = Clock::now();
   state->frame = r.servo.frame;
   rec->integration = Integrate(&run->map, r.foveal.patches, state->frame.left, integration);
-  if (integration.retire_idr)
-    rec->integration.retired_idr = static_cast<int>(
-        run->map.Remove(CoveredIdrPatches(run->map, idr_view, integration.overlap_share)));
+  if (integration.retire_idr) {
+    // Covered in the IDR view or in this fixation's: the views differ in
+    // where they stand and what they see past the nearer surfaces.
+    std::vector<char> retire = CoveredIdrPatches(run->map, idr_view, integration.retire_idr_share);
+    if (integration.retire_in_fixation_view) {
+      const std::vector<char> here =
+          CoveredIdrPatches(run->map, state->frame.left, integration.retire_idr_share);
+      for (size_t i = 0; i < retire.size(); ++i) retire[i] |= here[i];
+    }
+    rec->integration.retired_idr = static_cast<int>(run->map.Remove(retire));
+  }
   run->map.BuildIndex();
   rec->time.integrate_s = Since(t);
   rec->map_by_level = run->map.CountByLevel();

@@ -26,10 +26,21 @@ struct IntegrationOptions {
   /// shows the same surface at the same or a finer level.
   bool fuse = true;
   /// Beyond the paper: after each fixation, IDR patches whose footprint in
-  /// the IDR view finer patches (of any fixations) cover by overlap_share are
-  /// removed (CoveredIdrPatches). false: an IDR patch goes only when one
-  /// fixation's new patches cover it in that fixation's view.
+  /// the IDR view, or in the fixation's own view, finer patches (of any
+  /// fixations) cover by retire_idr_share are removed (CoveredIdrPatches).
+  /// false: an IDR patch goes only when one fixation's new patches cover it
+  /// in that fixation's view by overlap_share.
   bool retire_idr = true;
+  /// The share of its footprint finer patches must cover for an IDR patch
+  /// to be retired. Below overlap_share: an IDR patch is a coarse guess
+  /// (near depth edges about half its pixels are more than 1% off), and the
+  /// uncovered rest of one 75% covered is mostly its border.
+  double retire_idr_share = 0.75;
+  /// Whether the fixation's own view counts too (false: the IDR view only).
+  /// The views stand apart and see different parts past nearer surfaces: a
+  /// patch the IDR view sees mostly uncovered can be covered where the
+  /// fixation looked.
+  bool retire_in_fixation_view = true;
   void Check() const;  ///< throws rig::InputError naming the key (fovea/params.h)
 };
 
@@ -40,7 +51,7 @@ struct IntegrationStats {
   int added_outside_view = 0;    ///< new patches with no footprint in the view (added as they are)
   int dropped_contradicted = 0;  ///< new patches dropped: the map contradicts them
   int fused = 0;                 ///< new patches fused with the map's depth
-  int retired_idr = 0;           ///< IDR patches finer data covers in the IDR view (retire_idr)
+  int retired_idr = 0;           ///< IDR patches finer data covers (retire_idr)
   std::array<int, 3> replaced{0, 0, 0};              ///< old patches removed, by their PatchLevel
   std::array<int, 3> removed_contradicted{0, 0, 0};  ///< old patches new data contradicts, by level
 };
@@ -60,8 +71,11 @@ IntegrationStats Integrate(PatchMap* map, const PatchMap& fresh, const rig::Came
 
 /// Which of the map's patches (in map order) are IDR patches whose
 /// footprint in `view` (the IDR patches rendered alone) the map's foveal and
-/// peripheral patches cover by `share` or more: the coarse guess adds
-/// nothing there. Two renders, O(N + pixels).
+/// peripheral patches (rendered alone) cover by `share` or more, at the IDR
+/// patch's surface or in front of it: the coarse guess adds nothing there.
+/// Finer data behind an IDR patch does not cover it: that is a farther
+/// surface seen past the IDR patch's edge from another viewpoint. Two
+/// renders, O(N + pixels).
 std::vector<char> CoveredIdrPatches(const PatchMap& map, const rig::CameraView& view, double share);
 
 }  // namespace fovea

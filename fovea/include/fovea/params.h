@@ -324,8 +324,18 @@ inline constexpr ParamSpec kIntegrationFuse{
 inline constexpr ParamSpec kIntegrationRetireIdr{
     "integration.retire_idr",
     "beyond the paper: after each fixation, remove the IDR patches whose footprint in the IDR view "
-    "the map's finer patches cover by integration.overlap_share (false: only one fixation's new "
-    "patches replace them)"};
+    "(and, with integration.retire_in_fixation_view, in the fixation's view) the map's finer "
+    "patches cover by integration.retire_idr_share (false: only one fixation's new patches "
+    "replace them, by integration.overlap_share)"};
+inline constexpr ParamSpec kIntegrationRetireIdrShare{
+    "integration.retire_idr_share",
+    "beyond the paper: with integration.retire_idr, the share of an IDR patch's footprint that "
+    "finer patches must cover for it to be removed",
+    0.05, 1};
+inline constexpr ParamSpec kIntegrationRetireInFixationView{
+    "integration.retire_in_fixation_view",
+    "beyond the paper: with integration.retire_idr, IDR patches covered in the fixation's own "
+    "view are retired too (false: in the IDR view only)"};
 inline constexpr ParamSpec kLoopFixations{"loop.fixations", "successful fixations to make", 1,
                                           10000};
 inline constexpr ParamSpec kLoopStayInIdrView{

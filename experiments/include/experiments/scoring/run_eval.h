@@ -14,6 +14,11 @@
 
 namespace experiments {
 
+/// The pixels on either side of a jump of more than kEdgeJumpM between
+/// neighbouring pixels of `depth_m` (CV_32F; 0, nothing, counts as
+/// infinitely far), CV_8U 255.
+cv::Mat DepthEdges(const cv::Mat& depth_m);
+
 /// The reference view and its truth.
 struct ReferenceView {
   rig::CameraView view;  ///< left camera at home: image, pose, intrinsics
@@ -30,8 +35,12 @@ struct ReferenceView {
   /// itself (rig::LeftCameraPair) sees there.
   cv::Mat stereo_visible;
   long stereo_visible_pixels = 0;
-  /// CV_8U, 255 within kEdgeRadiusPx of a true depth discontinuity of more
-  /// than kEdgeJumpM (or of a surface's silhouette against nothing).
+  /// CV_8U, 255 on either side of a true depth discontinuity of more than
+  /// kEdgeJumpM (or of a surface's silhouette against nothing), found in the
+  /// true camera's depth (on an imperfect rig, before it is carried to the
+  /// delivered camera's axis).
+  cv::Mat depth_edges;
+  /// CV_8U, 255 within kEdgeRadiusPx of a depth_edges pixel.
   cv::Mat near_edge;
 };
 
@@ -104,8 +113,9 @@ struct MapScore {
   int patches_scored = 0;
   /// With the per-patch figures: IDR patches whose footprint in the reference
   /// view finer (peripheral or foveal) patches cover, at least
-  /// kStaleCoveredShare of it, whatever their depths: coarse data the
-  /// replacement rule should have removed.
+  /// kStaleCoveredShare of it, at the IDR patch's surface or in front of it
+  /// (fovea::CoveredIdrPatches): coarse data the replacement rule should
+  /// have removed.
   int stale_idr_patches = 0;
 };
 
@@ -120,7 +130,7 @@ int StaleIdrPatches(const fovea::PatchMap& map, const rig::CameraView& view);
 /// score counts) green within kBadShare of the true depth; beyond it, red
 /// where the map is nearer than the truth and magenta where it is farther
 /// (brighter the larger the error, full at 5%); the true depth
-/// discontinuities (either side of each jump) blue.
+/// discontinuities (ref.depth_edges, if set) blue.
 cv::Mat ErrorPicture(const fovea::PatchMap& map, const ReferenceView& ref);
 
 /// Scores `map` in the reference view; `baseline_m` sets the disparity step.
