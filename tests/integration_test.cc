@@ -270,19 +270,19 @@ TEST_CASE("IDR patches are retired where finer patches of several fixations cove
   map.Add(square(-0.1, 0.0, 0.05, 0.1));
   map.Add(square(0.1, 0.0, 0.1, 0.1, 1.6));
   map.Add(square(0.2, 0.0, 0.1, 0.1, 0.8));
-  const std::vector<char> covered = fovea::CoveredIdrPatches(map, view, 0.9);
+  const std::vector<char> covered = fovea::CoveredIdrPatches(map, {view}, 0.9);
   REQUIRE(covered.size() == map.size());
   CHECK(std::count(covered.begin(), covered.end(), 1) == 2);
   CHECK(covered[55] == 1);
   CHECK(covered[65] == 0);
   CHECK(covered[75] == 1);
-  const std::vector<char> half = fovea::CoveredIdrPatches(map, view, 0.4);
+  const std::vector<char> half = fovea::CoveredIdrPatches(map, {view}, 0.4);
   CHECK(std::count(half.begin(), half.end(), 1) == 3);
   CHECK(half[45] == 1);
   CHECK(half[65] == 0);
   CHECK(std::count(half.begin() + 100, half.end(), 1) == 0);  // finer patches never
   // Without finer patches nothing is covered.
   const std::vector<char> none =
-      fovea::CoveredIdrPatches(Grid(10, 0.5, 1.0, fovea::PatchLevel::kIdr), view, 0.0);
+      fovea::CoveredIdrPatches(Grid(10, 0.5, 1.0, fovea::PatchLevel::kIdr), {view}, 0.0);
   CHECK(std::count(none.begin(), none.end(), 1) == 0);
 }

@@ -203,7 +203,7 @@ ReferenceView MakeReferenceView(rig::Rig& rig, sim::Simulation& sim) {
 }
 
 int StaleIdrPatches(const fovea::PatchMap& map, const rig::CameraView& view) {
-  const std::vector<char> covered = fovea::CoveredIdrPatches(map, view, kStaleCoveredShare);
+  const std::vector<char> covered = fovea::CoveredIdrPatches(map, {view}, kStaleCoveredShare);
   return static_cast<int>(std::count(covered.begin(), covered.end(), 1));
 }
 

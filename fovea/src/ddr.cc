@@ -155,13 +155,10 @@ void Absorb(const FixationResult& r, const rig::CameraView& idr_view,
   if (integration.retire_idr) {
     // Covered in the IDR view or in this fixation's: the views differ in
     // where they stand and what they see past the nearer surfaces.
-    std::vector<char> retire = CoveredIdrPatches(run->map, idr_view, integration.retire_idr_share);
-    if (integration.retire_in_fixation_view) {
-      const std::vector<char> here =
-          CoveredIdrPatches(run->map, state->frame.left, integration.retire_idr_share);
-      for (size_t i = 0; i < retire.size(); ++i) retire[i] |= here[i];
-    }
-    rec->integration.retired_idr = static_cast<int>(run->map.Remove(retire));
+    std::vector<rig::CameraView> views{idr_view};
+    if (integration.retire_in_fixation_view) views.push_back(state->frame.left);
+    rec->integration.retired_idr = static_cast<int>(
+        run->map.Remove(CoveredIdrPatches(run->map, views, integration.retire_idr_share)));
   }
   run->map.BuildIndex();
   rec->time.integrate_s = Since(t);

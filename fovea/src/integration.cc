@@ -230,7 +230,7 @@ IntegrationStats Integrate(PatchMap* map, const PatchMap& fresh_in, const rig::C
   return stats;
 }
 
-std::vector<char> CoveredIdrPatches(const PatchMap& map, const rig::CameraView& view,
+std::vector<char> CoveredIdrPatches(const PatchMap& map, const std::vector<rig::CameraView>& views,
                                     double share) {
   std::vector<char> covered_idr(map.size(), 0);
   PatchMap idr, finer;
@@ -244,24 +244,26 @@ std::vector<char> CoveredIdrPatches(const PatchMap& map, const rig::CameraView& 
     }
   }
   if (idr.size() == 0 || finer.size() == 0) return covered_idr;
-  cv::Mat idr_depth, idr_ids, finer_depth, finer_ids;
-  idr.Render(view.world_T_camera, view.intrinsics, &idr_depth, &idr_ids);
-  finer.Render(view.world_T_camera, view.intrinsics, &finer_depth, &finer_ids);
-  std::vector<long> footprint(idr.size(), 0), covered(idr.size(), 0);
-  for (int y = 0; y < idr_ids.rows; ++y)
-    for (int x = 0; x < idr_ids.cols; ++x)
-      if (const int id = idr_ids.at<int>(y, x); id >= 0) {
-        ++footprint[id];
-        const int f = finer_ids.at<int>(y, x);
-        if (f < 0) continue;
-        // Finer data behind the IDR patch is another surface it hides (the
-        // background seen past a near box's edge from another viewpoint),
-        // not a measurement of its own.
-        const double zi = idr_depth.at<float>(y, x), zf = finer_depth.at<float>(y, x);
-        covered[id] += zf <= zi || PatchMap::SameSurface(zi, idr[id], zf, finer[f]);
-      }
-  for (size_t k = 0; k < idr.size(); ++k)
-    covered_idr[idr_index[k]] = footprint[k] > 0 && covered[k] >= share * footprint[k];
+  for (const rig::CameraView& view : views) {
+    cv::Mat idr_depth, idr_ids, finer_depth, finer_ids;
+    idr.Render(view.world_T_camera, view.intrinsics, &idr_depth, &idr_ids);
+    finer.Render(view.world_T_camera, view.intrinsics, &finer_depth, &finer_ids);
+    std::vector<long> footprint(idr.size(), 0), covered(idr.size(), 0);
+    for (int y = 0; y < idr_ids.rows; ++y)
+      for (int x = 0; x < idr_ids.cols; ++x)
+        if (const int id = idr_ids.at<int>(y, x); id >= 0) {
+          ++footprint[id];
+          const int f = finer_ids.at<int>(y, x);
+          if (f < 0) continue;
+          // Finer data behind the IDR patch is another surface it hides (the
+          // background seen past a near box's edge from another viewpoint),
+          // not a measurement of its own.
+          const double zi = idr_depth.at<float>(y, x), zf = finer_depth.at<float>(y, x);
+          covered[id] += zf <= zi || PatchMap::SameSurface(zi, idr[id], zf, finer[f]);
+        }
+    for (size_t k = 0; k < idr.size(); ++k)
+      covered_idr[idr_index[k]] |= footprint[k] > 0 && covered[k] >= share * footprint[k];
+  }
   return covered_idr;
 }
 

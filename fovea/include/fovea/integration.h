@@ -3,6 +3,8 @@
 // where the patches project in the current left view.
 #pragma once
 
+#include <vector>
+
 #include "fovea/patch.h"
 #include "rig/types.h"
 
@@ -70,12 +72,13 @@ IntegrationStats Integrate(PatchMap* map, const PatchMap& fresh, const rig::Came
                            const IntegrationOptions& options = {});
 
 /// Which of the map's patches (in map order) are IDR patches whose
-/// footprint in `view` (the IDR patches rendered alone) the map's foveal and
-/// peripheral patches (rendered alone) cover by `share` or more, at the IDR
-/// patch's surface or in front of it: the coarse guess adds nothing there.
-/// Finer data behind an IDR patch does not cover it: that is a farther
-/// surface seen past the IDR patch's edge from another viewpoint. Two
-/// renders, O(N + pixels).
-std::vector<char> CoveredIdrPatches(const PatchMap& map, const rig::CameraView& view, double share);
+/// footprint in any of `views` (the IDR patches rendered alone) the map's
+/// foveal and peripheral patches (rendered alone) cover by `share` or more,
+/// at the IDR patch's surface or in front of it: the coarse guess adds
+/// nothing there. Finer data behind an IDR patch does not cover it: that is
+/// a farther surface seen past the IDR patch's edge from another viewpoint.
+/// One split of the map, two renders per view: O(N + views x pixels).
+std::vector<char> CoveredIdrPatches(const PatchMap& map, const std::vector<rig::CameraView>& views,
+                                    double share);
 
 }  // namespace fovea
