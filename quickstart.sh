@@ -52,12 +52,13 @@ case "${1:-}" in
     # clang, whose libFuzzer drives the fuzz targets (label "fuzz", 30 s each)
     # in the same build; -O1, no debug info: the usual sanitizer setting.
     # The Slurm test (label "slurm") ran in the release pass: it tests the
-    # cluster path, not memory.
+    # cluster path, not memory. So did the "outcome" tests, which check what
+    # whole runs achieve; their code runs here in the other end-to-end tests.
     build build-asan -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=None -DCMAKE_CXX_FLAGS=-O1 -DFOVEA_SANITIZE=ON -DFOVEA_FUZZ=ON
     ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
       LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp:print_suppressions=0 \
       UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-      ctest --test-dir build-asan -j "$JOBS" --output-on-failure -LE slurm
+      ctest --test-dir build-asan -j "$JOBS" --output-on-failure -LE 'slurm|outcome'
     ;;
   *)
     echo "usage: $0 run|test" >&2

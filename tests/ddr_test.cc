@@ -64,7 +64,8 @@ std::string Text(const fs::path& p) {
 
 }  // namespace
 
-TEST_CASE("fovea run: the same seed gives the same run, another seed another one", "[ddr][slow]") {
+TEST_CASE("fovea run: the same seed gives the same run, another seed another one",
+          "[ddr][slow][outcome]") {
   const fs::path a = Out("a"), b = Out("b"), c = Out("c");
   RunFovea("--scene two_planes --fixations 6 --seed 1", a);
   RunFovea("--scene two_planes --fixations 6 --seed 1", b);
@@ -145,7 +146,8 @@ TEST_CASE(
   fs::remove_all(out);
 }
 
-TEST_CASE("local suppression: without it, fixations revisit mapped places more", "[ddr][slow]") {
+TEST_CASE("local suppression: without it, fixations revisit mapped places more",
+          "[ddr][slow][outcome]") {
   auto revisits = [](const std::string& suppression) {
     const fs::path out = Out("sup" + suppression);
     RunFovea("--scene cylinder_planes --fixations 12 --set criteria.suppression=" + suppression,

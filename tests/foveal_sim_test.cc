@@ -10,7 +10,8 @@
 #include "scenes/catalog.h"
 #include "temp_scene.h"
 
-TEST_CASE("foveal and peripheral depth accuracy at three fixations per scene", "[foveal][slow]") {
+TEST_CASE("foveal and peripheral depth accuracy at three fixations per scene",
+          "[foveal][slow][outcome]") {
   struct Point {
     std::string scene;
     Eigen::Vector3d p_W;
@@ -189,7 +190,7 @@ ElevationFigures FixateAtElevation(double distance_m, double elevation_deg) {
 
 }  // namespace
 
-TEST_CASE("the fovea keeps its size at any elevation the heads reach", "[foveal][slow]") {
+TEST_CASE("the fovea keeps its size at any elevation the heads reach", "[foveal][slow][outcome]") {
   // Issue 20: tilted verged heads twist their rows against each other; in
   // the fixation frame the fovea stays the level fixation's (measured 0.99 to
   // 1.02 of it, against 0.04-0.17 unrectified beyond 10 degrees), and foveal

@@ -63,7 +63,7 @@ TEST_CASE("ray-cast depth works for any intrinsics, rendering refuses what it ca
 }
 
 TEST_CASE("rendered labels agree with exact ray casting on every pixel of every catalog scene",
-          "[sim][slow]") {
+          "[sim][slow][outcome]") {
   int total_cast = 0, total_pixels = 0;
   for (const std::string& name : scenes::CatalogNames()) {
     INFO("scene " << name);

@@ -49,7 +49,7 @@ const fovea::DepthRange kEveryDepth{0.4, fovea::kFarDepthM};
 
 }  // namespace
 
-TEST_CASE("servoing converges from 20 px off within 6 steps", "[fovea][servo][slow]") {
+TEST_CASE("servoing converges from 20 px off within 6 steps", "[fovea][servo][slow][outcome]") {
   struct Point {
     std::string scene;
     Eigen::Vector3d p_W;

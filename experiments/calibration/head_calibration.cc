@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <numeric>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 #include <optional>
@@ -291,6 +292,40 @@ void SaveHeadViews(const std::string& path, const std::vector<HeadView>& views) 
   WriteTextAtomic(path, std::string(out.c_str()) + "\n");
 }
 
+namespace {
+
+// Throws UsageError unless side `s`'s stage readings over `used` views can
+// determine the head model: 6 distinct states, pan and tilt spanning 5 deg,
+// the carriage 0.05 m.
+void CheckStageSpread(const std::vector<HeadView>& views, const std::vector<int>& used, int s) {
+  const std::string side = s == 0 ? "left" : "right";
+  double pan_lo = 1e9, pan_hi = -1e9, tilt_lo = 1e9, tilt_hi = -1e9, car_lo = 1e9, car_hi = -1e9;
+  std::set<std::array<long long, 3>> states;
+  for (const int v : used) {
+    const rig::CameraStage& st = views[v].state[static_cast<rig::Side>(s)];
+    pan_lo = std::min(pan_lo, st.pan_rad), pan_hi = std::max(pan_hi, st.pan_rad);
+    tilt_lo = std::min(tilt_lo, st.tilt_rad), tilt_hi = std::max(tilt_hi, st.tilt_rad);
+    car_lo = std::min(car_lo, st.carriage_m), car_hi = std::max(car_hi, st.carriage_m);
+    states.insert({std::llround(st.carriage_m * 1e5), std::llround(st.pan_rad * 1e5),
+                   std::llround(st.tilt_rad * 1e5)});
+  }
+  if (states.size() < 6)
+    throw UsageError("calibrate-head: the " + side + " head was seen at only " +
+                     std::to_string(states.size()) +
+                     " distinct stage states (the head model needs 6 or more)");
+  if (pan_hi - pan_lo < 5 * kDeg || tilt_hi - tilt_lo < 5 * kDeg)
+    throw UsageError("calibrate-head: cannot determine the " + side +
+                     " camera's mount: its pan readings span " + Degrees(pan_hi - pan_lo) +
+                     " deg and its tilt readings " + Degrees(tilt_hi - tilt_lo) +
+                     " deg; both must span 5 deg or more");
+  if (car_hi - car_lo < 0.05)
+    throw UsageError("calibrate-head: cannot determine the " + side +
+                     " pan zero: its carriage readings span " + Short(car_hi - car_lo) +
+                     " m; vary the carriages by 0.05 m or more");
+}
+
+}  // namespace
+
 HeadCalibrationResult CalibrateHead(const std::vector<HeadView>& views, int cols, int rows,
                                     double square_m) {
   const std::vector<cv::Point3f> board = board::Corners("calibrate-head", cols, rows, square_m);
@@ -299,6 +334,15 @@ HeadCalibrationResult CalibrateHead(const std::vector<HeadView>& views, int cols
   Model model;
   model.views = &views;
   model.board = &board;
+  // Readings that cannot determine the model fail before any image is read
+  // (finding the boards is the slow part); the same check runs again below
+  // on the views whose boards were found. Too few views are said as too few
+  // boards found, below.
+  constexpr size_t kMinViews = 8;
+  std::vector<int> all(views.size());
+  std::iota(all.begin(), all.end(), 0);
+  if (views.size() >= kMinViews)
+    for (int s = 0; s < 2; ++s) CheckStageSpread(views, all, s);
   cv::Size size;
   std::set<int> placements;
   for (size_t i = 0; i < views.size(); ++i) {
@@ -318,37 +362,16 @@ HeadCalibrationResult CalibrateHead(const std::vector<HeadView>& views, int cols
   }
 
   // What the head model needs of the data, said before any fitting.
-  constexpr int kMinViews = 8;
   for (int s = 0; s < 2; ++s) {
-    const char* side = s == 0 ? "left" : "right";
-    if (result.views[s] < kMinViews)
+    if (result.views[s] < static_cast<int>(kMinViews))
       throw UsageError("calibrate-head: the " + std::to_string(cols) + "x" + std::to_string(rows) +
-                       " board was found in only " + std::to_string(result.views[s]) + " " + side +
-                       " images (need " + std::to_string(kMinViews) + " or more)");
-    double pan_lo = 1e9, pan_hi = -1e9, tilt_lo = 1e9, tilt_hi = -1e9, car_lo = 1e9, car_hi = -1e9;
-    std::set<std::array<long long, 3>> states;
-    for (const Observation& o : model.observations) {
-      if (o.side != s) continue;
-      const rig::CameraStage& st = views[o.view].state[static_cast<rig::Side>(s)];
-      pan_lo = std::min(pan_lo, st.pan_rad), pan_hi = std::max(pan_hi, st.pan_rad);
-      tilt_lo = std::min(tilt_lo, st.tilt_rad), tilt_hi = std::max(tilt_hi, st.tilt_rad);
-      car_lo = std::min(car_lo, st.carriage_m), car_hi = std::max(car_hi, st.carriage_m);
-      states.insert({std::llround(st.carriage_m * 1e5), std::llround(st.pan_rad * 1e5),
-                     std::llround(st.tilt_rad * 1e5)});
-    }
-    if (states.size() < 6)
-      throw UsageError("calibrate-head: the " + std::string(side) + " head was seen at only " +
-                       std::to_string(states.size()) +
-                       " distinct stage states (the head model needs 6 or more)");
-    if (pan_hi - pan_lo < 5 * kDeg || tilt_hi - tilt_lo < 5 * kDeg)
-      throw UsageError("calibrate-head: cannot determine the " + std::string(side) +
-                       " camera's mount: its pan readings span " + Degrees(pan_hi - pan_lo) +
-                       " deg and its tilt readings " + Degrees(tilt_hi - tilt_lo) +
-                       " deg; both must span 5 deg or more");
-    if (car_hi - car_lo < 0.05)
-      throw UsageError("calibrate-head: cannot determine the " + std::string(side) +
-                       " pan zero: its carriage readings span " + Short(car_hi - car_lo) +
-                       " m; vary the carriages by 0.05 m or more");
+                       " board was found in only " + std::to_string(result.views[s]) + " " +
+                       (s == 0 ? "left" : "right") + " images (need " + std::to_string(kMinViews) +
+                       " or more)");
+    std::vector<int> seen;  // the views whose image of side s showed the board
+    for (const Observation& o : model.observations)
+      if (o.side == s) seen.push_back(o.view);
+    CheckStageSpread(views, seen, s);
   }
   model.placements = *placements.rbegin() + 1;
   result.placements = static_cast<int>(placements.size());

@@ -203,12 +203,14 @@ int Run(const RunArgs& args) {
   const RunConfig config = EffectiveConfig(args);
   OutputFolder folder(args.out, "--out", ExistingPolicy(args.force));
   if (config.method == "static_sgbm") return RunStatic(config, folder, t_wall);
-  // The scene's model: the simulated rig, and the ground truth every run is
-  // scored against (on hardware, the model of the scene in front of it).
-  auto sim = LoadSceneOf(config);
+  // The real rig first: its port, cameras and calibration are checked in
+  // moments (no stage moves yet), before the scene's model loads.
   std::unique_ptr<rig::IndexerEmulator> emulator;
   std::unique_ptr<rig::HardwareRig> hardware;
   if (config.hardware.type == "hardware") hardware = MakeHardwareRig(config, &emulator);
+  // The scene's model: the simulated rig, and the ground truth every run is
+  // scored against (on hardware, the model of the scene in front of it).
+  auto sim = LoadSceneOf(config);
   rig::Rig& rig = hardware ? static_cast<rig::Rig&>(*hardware) : sim->rig();
   if (!config.rig.record_dir.empty()) EnsureDirectory(config.rig.record_dir);
   const std::string dir = folder.path();
