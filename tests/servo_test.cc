@@ -210,3 +210,41 @@ TEST_CASE(
   CHECK(step.ok);
   CHECK((step.fixation_W - Eigen::Vector3d(-0.1, 0.805, 0.005)).norm() < 0.02);
 }
+
+TEST_CASE("a hole's prescreen asks the servo's mutual check of the pair it has", "[fovea][servo]") {
+  // A parallel pair 0.1 m apart looking along +z, 320 x 240 px at 30 deg
+  // (fx 597 px): depths 0.5-5 m are disparities of 119-12 px. Both images
+  // are independent noise but for a 41 x 41 texture T, in the right image at
+  // x 140 and in the left at x 200 (1 m away), slightly noisier there.
+  rig::StereoFrame f;
+  for (rig::CameraView* v : {&f.left, &f.right}) {
+    v->intrinsics = rig::CameraIntrinsics::FromHorizontalFov(320, 240, 30 * M_PI / 180);
+    v->gray = cv::Mat(240, 320, CV_8U);
+  }
+  f.right.world_T_camera.translation() = Eigen::Vector3d(0.1, 0, 0);
+  cv::RNG rng(7);
+  rng.fill(f.left.gray, cv::RNG::UNIFORM, 0, 256);
+  rng.fill(f.right.gray, cv::RNG::UNIFORM, 0, 256);
+  cv::Mat t(41, 41, CV_8U), noisy;
+  rng.fill(t, cv::RNG::UNIFORM, 40, 216);
+  cv::Mat noise(41, 41, CV_16S);
+  rng.fill(noise, cv::RNG::UNIFORM, -25, 26);
+  cv::Mat t16;
+  t.convertTo(t16, CV_16S);
+  cv::Mat(t16 + noise).convertTo(noisy, CV_8U);
+  t.copyTo(f.right.gray(cv::Rect(140 - 20, 100, 41, 41)));
+  noisy.copyTo(f.left.gray(cv::Rect(200 - 20, 100, 41, 41)));
+  const Eigen::Vector2d pixel(200, 120);
+  const fovea::DepthRange depths{0.5, 5.0};
+  fovea::ServoOptions o;
+  REQUIRE(o.mutual_tolerance_px > 0);
+  CHECK(fovea::UniqueAlongRay(f, pixel, depths, o));
+  // An exact copy of T in the left image 40 px further right, within the
+  // right window's ray: its best match is no longer the pixel asked about.
+  // The match forward stays unique (the right image holds T once), so only
+  // the mutual check refuses it.
+  t.copyTo(f.left.gray(cv::Rect(240 - 20, 100, 41, 41)));
+  CHECK_FALSE(fovea::UniqueAlongRay(f, pixel, depths, o));
+  o.mutual_tolerance_px = 0;  // no mutual check: unique forward is enough
+  CHECK(fovea::UniqueAlongRay(f, pixel, depths, o));
+}

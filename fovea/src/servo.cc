@@ -165,38 +165,65 @@ std::optional<double> CentreDisparity(const rig::StereoFrame& frame, const Servo
                    static_cast<int>(std::ceil(hi)) + 1, o.unique_ratio);
 }
 
-bool UniqueAlongRay(const rig::StereoFrame& frame, const Eigen::Vector2d& pixel,
-                    const DepthRange& depths, const ServoOptions& o) {
-  const cv::Mat& l = frame.left.gray;
-  const cv::Mat& r = frame.right.gray;
-  const int h = o.window_half_px;
-  const int xl = static_cast<int>(std::lround(pixel.x())),
-            yl = static_cast<int>(std::lround(pixel.y()));
-  if (xl - h < 0 || yl - h < 0 || xl + h >= l.cols || yl + h >= l.rows) return false;
-  if (!Textured(l, xl, yl, h)) return false;
-  // The ray's points by inverse depth, about a pixel apart in the right image.
-  const Eigen::Vector3d ray_L = frame.left.intrinsics.Ray(pixel);
-  const Eigen::Isometry3d right_T_left =
-      frame.right.world_T_camera.inverse() * frame.left.world_T_camera;
+namespace {
+
+// The costs of `from`'s window at `pixel` against `to`'s windows at the
+// projections of the depths [near, far] along its ray, sampled by inverse
+// depth about a pixel apart in `to`, with the pixels compared (1e300 where a
+// window leaves the image). Empty when the range does not project.
+struct RayCosts {
+  std::vector<double> cost;
+  std::vector<cv::Point> at;
+};
+RayCosts CostsAlongRay(const rig::CameraView& from, const rig::CameraView& to, cv::Point pixel,
+                       const DepthRange& depths, int h) {
+  const cv::Mat& l = from.gray;
+  const cv::Mat& r = to.gray;
+  const Eigen::Vector3d ray = from.intrinsics.Ray(Eigen::Vector2d(pixel.x, pixel.y));
+  const Eigen::Isometry3d to_T_from = to.world_T_camera.inverse() * from.world_T_camera;
   auto project = [&](double inverse_depth) -> std::optional<Eigen::Vector2d> {
-    const Eigen::Vector3d p = right_T_left * (ray_L / std::max(inverse_depth, 1e-9));
+    const Eigen::Vector3d p = to_T_from * (ray / std::max(inverse_depth, 1e-9));
     if (p.z() <= 1e-6) return std::nullopt;
-    return frame.right.intrinsics.Project(p);
+    return to.intrinsics.Project(p);
   };
   const double w_near = 1 / depths.near_m, w_far = 1 / depths.far_m;
   const auto a = project(w_near), b = project(w_far);
-  if (!a || !b) return false;
+  if (!a || !b) return {};
   const int n = std::clamp(static_cast<int>(std::ceil((*a - *b).norm())) + 1, 3, 2000);
-  std::vector<double> cost(n, 1e300);
+  RayCosts c{std::vector<double>(n, 1e300), std::vector<cv::Point>(n, cv::Point(-1, -1))};
   for (int i = 0; i < n; ++i) {
     const auto uv = project(w_far + (w_near - w_far) * i / (n - 1));
     if (!uv) continue;
     const int xr = static_cast<int>(std::lround(uv->x())),
               yr = static_cast<int>(std::lround(uv->y()));
     if (xr - h < 0 || yr - h < 0 || xr + h >= r.cols || yr + h >= r.rows) continue;
-    cost[i] = NormalizedL1(l, xl, yl, r, xr, yr, h);
+    c.at[i] = {xr, yr};
+    c.cost[i] = NormalizedL1(l, pixel.x, pixel.y, r, xr, yr, h);
   }
-  return UniqueMinimum(cost, h, o.unique_ratio).has_value();
+  return c;
+}
+
+}  // namespace
+
+bool UniqueAlongRay(const rig::StereoFrame& frame, const Eigen::Vector2d& pixel,
+                    const DepthRange& depths, const ServoOptions& o) {
+  const cv::Mat& l = frame.left.gray;
+  const int h = o.window_half_px;
+  const cv::Point p(static_cast<int>(std::lround(pixel.x())),
+                    static_cast<int>(std::lround(pixel.y())));
+  if (p.x - h < 0 || p.y - h < 0 || p.x + h >= l.cols || p.y + h >= l.rows) return false;
+  if (!Textured(l, p.x, p.y, h)) return false;
+  const RayCosts forward = CostsAlongRay(frame.left, frame.right, p, depths, h);
+  const std::optional<int> best = UniqueMinimum(forward.cost, h, o.unique_ratio);
+  if (!best) return false;
+  if (!(o.mutual_tolerance_px > 0)) return true;
+  // Mutual, as the servo will ask once verged: the right window's best match
+  // along its own ray over the same depths falls back on the left pixel.
+  const RayCosts back = CostsAlongRay(frame.right, frame.left, forward.at[*best], depths, h);
+  const std::optional<int> back_best = UniqueMinimum(back.cost, h, 1.0);
+  if (!back_best) return false;
+  const cv::Point d = back.at[*back_best] - p;
+  return std::hypot(d.x, d.y) < o.mutual_tolerance_px;
 }
 
 ServoResult Servo(rig::Rig& rig, const rig::StageState& start, const ServoOptions& o,

@@ -68,7 +68,10 @@ std::optional<double> CentreDisparity(const rig::StereoFrame& frame, const Servo
 /// right image's windows at the projections of the depths [near, far] along
 /// its ray (normalized L1, windows of options.window_half_px, unique as in
 /// the depth-range CentreDisparity: no other minimum within
-/// options.unique_ratio of the best, and the best not at the range's end).
+/// options.unique_ratio of the best, and the best not at the range's end);
+/// with options.mutual_tolerance_px, that match's window must also find its
+/// best match along its own ray, over the same depths, within that many
+/// pixels of `pixel` (the servo's mutual check, asked in advance).
 /// For any pair, verged or not: the loop asks it of a hole before moving
 /// the rig there, from the images it has.
 bool UniqueAlongRay(const rig::StereoFrame& frame, const Eigen::Vector2d& pixel,
