@@ -91,6 +91,7 @@ void Couple(const std::string& key, double value, experiments::RunConfig* c) {
   if (key == "rig.carriage_max_m" && value < 0.05) {
     SetParam(c, "rig.home_baseline_m", "0.01");
     SetParam(c, "foveal.baseline_m", "0.01");
+    SetParam(c, "foveal.mapped_baseline_m", "0.01");
   }
   if (key == "idr.min_expansion" && value > 4) SetParam(c, "idr.max_expansion", "16");
 }

@@ -120,8 +120,8 @@ TEST_CASE(
   }
   // Near plane at y = 0.6 m, far plane at 1.3 m. The choice is a draw from
   // the criteria's histogram, so the path varies with the seed and every
-  // setting (seed 0: NNNNNNNNFFFFNFFFFFFFFFFFF, seed 1:
-  // NNNNNNNNFFFFFFFFFFFFFFFFF): the nearest textured surface first, then
+  // setting (seed 0: NNNNNNNNNFFFFFFFFFFFFFFFF, seed 1:
+  // NNNNNFFFFFFNNNNFFFFFFFFFF): the nearest textured surface first, then
   // both planes get fixations and both end mapped.
   std::vector<bool> near;
   for (const auto& r : records)

@@ -91,6 +91,7 @@ TEST_CASE("a guessed depth: the servo searches every depth and finds the surface
   // ordinary search.
   fovea::FixationOptions o = fovea::ResolvedFixationOptions({});  // the run's
   o.baseline_m = 0.12;
+  o.mapped_baseline_m = 0;     // the narrow search below at 0.12 m too
   o.choose_placement = false;  // the symmetric carriages OnLeftAxis assumes
   const Eigen::Vector3d block(-0.11, 0.50, -0.055);
   const Eigen::Vector3d guess = OnLeftAxis(rig, block, 2.4, o.baseline_m);
@@ -191,6 +192,7 @@ TEST_CASE(
   REQUIRE(idr.map.size() > 100);
   fovea::FixationOptions o = fovea::ResolvedFixationOptions({});  // the run's
   o.choose_placement = false;  // the symmetric carriages OnLeftAxis assumes
+  o.mapped_baseline_m = 0;     // and its baseline, though the map holds the point
   const Eigen::Vector3d air = OnLeftAxis(rig, {-0.1, 1.0, 0.0}, 0.4, o.baseline_m);
   o.map_check = false;
   const fovea::FixationResult trusting = fovea::Fixate(rig, idr.map, air, matcher, o);
@@ -247,4 +249,40 @@ TEST_CASE("a hole's prescreen asks the servo's mutual check of the pair it has",
   CHECK_FALSE(fovea::UniqueAlongRay(f, pixel, depths, o));
   o.mutual_tolerance_px = 0;  // no mutual check: unique forward is enough
   CHECK(fovea::UniqueAlongRay(f, pixel, depths, o));
+}
+
+TEST_CASE("a point the map holds verges at foveal.mapped_baseline_m, a hole's at foveal.baseline_m",
+          "[fovea][servo]") {
+  auto sim = NoisyScene("two_planes");
+  const fovea::Nl1Matcher matcher;
+  fovea::FixationOptions o = fovea::ResolvedFixationOptions({});  // the run's
+  REQUIRE(o.mapped_baseline_m > o.baseline_m);
+  o.choose_placement = false;  // symmetric carriages: their gap is the baseline
+  const Eigen::Vector3d near_plane(-0.15, 0.6, 0.02);  // its face: x -0.48 to 0.02, y 0.6
+  auto gap = [](const fovea::FixationResult& r) {
+    return r.vergence.state.right.carriage_m - r.vergence.state.left.carriage_m;
+  };
+  // Its depth known (no guessed depths): the wider baseline.
+  const fovea::FixationResult mapped =
+      fovea::Fixate(sim->rig(), fovea::PatchMap(), near_plane, matcher, o);
+  REQUIRE(mapped.ok);
+  CHECK(mapped.baseline_m == o.mapped_baseline_m);
+  CHECK(gap(mapped) == Approx(o.mapped_baseline_m).margin(1e-4));
+  CHECK((mapped.fixation_W - near_plane).norm() < 0.01);
+  // A hole's guessed depth: the narrow one, whose Z_T is wider.
+  const fovea::FixationResult hole = fovea::Fixate(sim->rig(), fovea::PatchMap(), near_plane,
+                                                   matcher, o, 0, fovea::DepthRange{0.4, 2.0});
+  REQUIRE(hole.ok);
+  CHECK(hole.baseline_m == o.baseline_m);
+  CHECK(gap(hole) == Approx(o.baseline_m).margin(1e-4));
+  // The wider pair's foveal depth band is narrower, as its depth step is.
+  const double band_mapped =
+                   mapped.foveal.tessellation.z_t_far_m - mapped.foveal.tessellation.z_t_near_m,
+               band_hole = hole.foveal.tessellation.z_t_far_m - hole.foveal.tessellation.z_t_near_m;
+  CHECK(band_mapped < band_hole);
+  // 0: every point at baseline_m.
+  o.mapped_baseline_m = 0;
+  const fovea::FixationResult same =
+      fovea::Fixate(sim->rig(), fovea::PatchMap(), near_plane, matcher, o);
+  CHECK(same.baseline_m == o.baseline_m);
 }

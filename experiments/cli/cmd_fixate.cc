@@ -104,8 +104,12 @@ int Fixate(const FixateArgs& args) {
   RunConfig config;  // the run's defaults: noise on
   SetParams(&config, args.set);
   args.scene.ApplyTo(&config);
-  if (!args.baseline.empty())
+  // The point fixated is the one asked for: --baseline is its baseline,
+  // whether the IDR map holds it or not.
+  if (!args.baseline.empty()) {
     SetParamFromFlag(&config, "--baseline", "foveal.baseline_m", args.baseline);
+    SetParamFromFlag(&config, "--baseline", "foveal.mapped_baseline_m", args.baseline);
+  }
   if (!args.matcher.empty()) SetParamFromFlag(&config, "--matcher", "matcher", args.matcher);
   config.Check();
   const Eigen::Vector3d p(*ParseNumber(args.point[0]), *ParseNumber(args.point[1]),
@@ -163,7 +167,8 @@ void AddFixateCommand(CLI::App& app, std::function<int()>* run) {
       ->check(NumberIn(-100, 100));
   cmd->add_option("--out", args->out, "output folder (new, or empty)")->required();
   AddForceFlag(cmd, &args->force);
-  cmd->add_option("--baseline", args->baseline, "vergent baseline, metres (foveal.baseline_m)");
+  cmd->add_option("--baseline", args->baseline,
+                  "vergent baseline, metres (foveal.baseline_m and foveal.mapped_baseline_m)");
   cmd->add_option("--set", args->set, "KEY=VALUE: set one parameter (repeatable)");
   cmd->add_option("--matcher", args->matcher,
                   "per-level matcher: nl1 (the paper's cost) or sgbm (matcher)");

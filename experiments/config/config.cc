@@ -263,6 +263,7 @@ void AddFovealParams(RunConfig* c, std::vector<ConfigParam>* params) {
   params->insert(params->end(),
                  {
                      {&fp::kFovealBaselineM, &x.baseline_m},
+                     {&fp::kFovealMappedBaselineM, &x.mapped_baseline_m},
                      {&fp::kFovealChoosePlacement, &x.choose_placement},
                      {&fp::kFovealLeftPair, &x.left_pair},
                      {&fp::kFovealMapCheck, &x.map_check},
@@ -555,6 +556,7 @@ void RunConfig::Check() const {
   const double widest = 2 * rig.carriage_max_m;
   for (const auto& [key, baseline] :
        {std::pair<const char*, double>{"foveal.baseline_m", fovea.fixation.baseline_m},
+        {"foveal.mapped_baseline_m", fovea.fixation.mapped_baseline_m},
         {"static.baseline_m", static_baseline_m}})
     if (baseline > widest)
       throw UsageError(std::string("key '") + key + "': " + FormatNumber(baseline) +

@@ -37,6 +37,7 @@ void AddFixation(const fovea::FixationRecord& r, nlohmann::json* j) {
                          {"left_tilt_rad", a[2]},   {"right_baseline_m", a[3]},
                          {"right_pan_rad", a[4]},   {"right_tilt_rad", a[5]}};
   (*j)["placement"] = fovea::PlacementName(r.placement);
+  (*j)["vergent_baseline_m"] = r.baseline_m;
   (*j)["servo"] = {{"iterations", r.servo_iterations},
                    {"residual_px", r.servo_residual_px},
                    {"converged", r.servo_converged}};

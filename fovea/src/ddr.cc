@@ -135,6 +135,7 @@ void RecordFixation(const FixationResult& r, FixationRecord* rec) {
   rec->servo_residual_px = r.servo.residual_px;
   rec->servo_converged = r.servo.converged;
   rec->placement = r.placement;
+  rec->baseline_m = r.baseline_m;
   rec->tessellation = r.foveal.tessellation;
   rec->tessellation.vertical_disparity_px.release();
   rec->tessellation.mask.release();

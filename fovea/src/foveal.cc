@@ -37,6 +37,7 @@ void FixationOptions::Check() const {
   servo.Check();
   foveal.Check();
   rig::CheckParam(params::kFovealBaselineM, baseline_m);
+  rig::CheckParam(params::kFovealMappedBaselineM, mapped_baseline_m);
   // Set from idr.z_min_m (ResolvedFixationOptions), not a parameter of its own.
   if (!(min_depth_m >= 0)) throw rig::InputError("fixation options: min_depth_m must be >= 0");
 }
@@ -464,16 +465,18 @@ FixationResult Fixate(rig::Rig& rig, const PatchMap& map, const Eigen::Vector3d&
                       const std::optional<DepthRange>& guessed_depths) {
   FixationResult r;
   const auto t0 = Clock::now();
+  r.baseline_m = !guessed_depths && options.mapped_baseline_m > 0 ? options.mapped_baseline_m
+                                                                  : options.baseline_m;
   if (options.choose_placement) {
     const PlacementChoice choice =
-        ChoosePlacement(PlacementRig::Of(rig, options.left_pair), map, p_W, options.baseline_m,
+        ChoosePlacement(PlacementRig::Of(rig, options.left_pair), map, p_W, r.baseline_m,
                         options.vergence, guessed_depths);
     r.placement = choice.placement;
     r.vergence = choice.vergence;
   } else {
     r.vergence = Verge(rig.Geometry(), rig.Limits(), rig.Intrinsics(rig::Side::kLeft),
-                       rig.Intrinsics(rig::Side::kRight),
-                       rig::StageState::Parallel(options.baseline_m), p_W, options.vergence);
+                       rig.Intrinsics(rig::Side::kRight), rig::StageState::Parallel(r.baseline_m),
+                       p_W, options.vergence);
   }
   if (!r.vergence.ok) {
     r.why = r.vergence.why;

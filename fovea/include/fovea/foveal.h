@@ -137,6 +137,12 @@ struct FixationOptions {
   /// larger fovea and Z_T, and a thinner strip of surface hidden from one
   /// camera beside a nearer surface's edge.
   double baseline_m = 0.06;
+  /// Beyond the paper: the vergent baseline for a point the map holds, its
+  /// depth known (0: baseline_m). Wider, it shrinks the foveal depth step
+  /// (depth^2 / (f b) per pixel of disparity) where the map already has a
+  /// coarser estimate to refine; a hole's point, its depth a guess, keeps
+  /// baseline_m, whose wider Z_T and larger fovea find the surface.
+  double mapped_baseline_m = 0.09;
   /// Beyond the paper: place the carriages per fixation (see
   /// ChoosePlacement) so that no mapped surface hides the point from either
   /// camera; false: always symmetric about the rail centre.
@@ -166,6 +172,7 @@ struct FixationResult {
   FovealResult foveal;
   double motion_time_s = 0, compute_time_s = 0;
   double verge_time_s = 0;  ///< inverse kinematics
+  double baseline_m = 0;    ///< the vergent baseline asked for (FixationOptions)
   double servo_wall_s = 0;  ///< the servo loop: moves, captures and measurements, wall clock
 };
 

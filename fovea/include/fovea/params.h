@@ -77,6 +77,11 @@ inline constexpr ParamSpec kIdrFitRequireQuadrants{
 // ---- Vergence, servo, tessellation, foveal stereo: FixationOptions (III) --
 inline constexpr ParamSpec kFovealBaselineM{"foveal.baseline_m", "vergent baseline, metres", 0.001,
                                             0.6};
+inline constexpr ParamSpec kFovealMappedBaselineM{
+    "foveal.mapped_baseline_m",
+    "beyond the paper: vergent baseline, metres, for a point the map holds (its depth known); a "
+    "hole's point keeps foveal.baseline_m (0: foveal.baseline_m for every point)",
+    0, 0.6};
 inline constexpr ParamSpec kFovealChoosePlacement{
     "foveal.choose_placement",
     "beyond the paper: place the carriages per fixation (symmetric, right or left carriage "
