@@ -92,8 +92,7 @@ struct FixationRecord {
   Eigen::Vector3d fixation_W = Eigen::Vector3d::Zero();
   rig::StageState state;
   Placement placement = Placement::kSymmetric;  ///< of the carriages
-  double baseline_m =
-      0;  ///< the vergent baseline asked for (foveal.baseline_m or mapped_baseline_m)
+  double baseline_m = 0;  ///< vergent baseline asked for (FixationResult::baseline_m)
   int servo_iterations = 0;
   double servo_residual_px = 0;
   bool servo_converged = false;
