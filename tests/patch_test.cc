@@ -240,3 +240,62 @@ TEST_CASE("erosion at disparity jumps drops the nearer side's edge, whatever NaN
   CHECK(n == expected);
   CHECK(expected > 0);
 }
+
+TEST_CASE("matches beside a wide unmatched stretch are found along rows and columns",
+          "[fovea][patch]") {
+  // A nearer surface (disparity 20) left of x = 20, the farther one
+  // unmatched (out of the search band) from there to the map's right side;
+  // inside the nearer surface a 4-pixel run of unmatched pixels in row 5 (a
+  // speck without texture) and a 12-pixel one in row 15 (x = 2 to 13).
+  const float kNaN = std::numeric_limits<float>::quiet_NaN();
+  cv::Mat d(24, 40, CV_32F, cv::Scalar(20));
+  d.colRange(20, 40).setTo(kNaN);
+  d(cv::Rect(4, 5, 4, 1)).setTo(kNaN);
+  d(cv::Rect(2, 15, 12, 1)).setTo(kNaN);
+  CHECK(cv::countNonZero(fovea::BesideUnmatchedRuns(d, 3, 0)) == 0);
+  CHECK(cv::countNonZero(fovea::BesideUnmatchedRuns(d, 0, 7)) == 0);
+  const cv::Mat beside = fovea::BesideUnmatchedRuns(d, 3, 7);
+  REQUIRE(beside.type() == CV_8U);
+  for (int y = 0; y < d.rows; ++y)
+    for (int x = 0; x < d.cols; ++x) {
+      // Within 3 pixels of the unmatched side, or along row 15 within 3 of
+      // its 12-pixel run; the speck and the runs of 1 that row 5 and row 15
+      // leave in their columns are shorter than 7.
+      const bool expected = (x >= 17 && x < 20) || (y == 15 && (x < 2 || (x >= 14 && x < 17)));
+      INFO("pixel (" << x << ", " << y << ")");
+      CHECK((beside.at<uchar>(y, x) != 0) == expected);
+    }
+}
+
+TEST_CASE("a block's matches beside an unmatched stretch count in its fit, not its footprint",
+          "[fovea][patch]") {
+  // One 16-pixel block: a plane of disparity 20 + 0.05 x over x < 12 (its
+  // last 3 columns a window's matches carried over the edge), unmatched
+  // beyond. Marked unbounded, the 3 columns still support the fit (all 192
+  // matches) but the patch stops at x = 8.
+  cv::Mat d(16, 16, CV_32F, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 12; ++x) d.at<float>(y, x) = 20.f + 0.05f * x;
+  const cv::Mat beside = fovea::BesideUnmatchedRuns(d, 3, 4);
+  fovea::PlaneFitOptions options;
+  fovea::BlockOptions blocks;
+  const auto plain = fovea::FitBlocks(d, 16, options, blocks, nullptr);
+  const auto clipped = fovea::FitBlocks(d, 16, options, blocks, nullptr, beside);
+  REQUIRE(plain.size() == 1);
+  REQUIRE(clipped.size() == 1);
+  CHECK(plain[0].footprint.isApprox(Eigen::Vector4d(-0.5, -0.5, 11.5, 15.5)));
+  CHECK(clipped[0].footprint.isApprox(Eigen::Vector4d(-0.5, -0.5, 8.5, 15.5)));
+  CHECK(clipped[0].fit.support == 192);
+  CHECK(clipped[0].fit.a == Approx(0.05).margin(1e-6));
+  CHECK(clipped[0].fit.c == Approx(20).margin(1e-5));
+  // A block whose every match lies beside the stretch yields no patch (with
+  // every block kept whole and no quadrant rule, it would otherwise).
+  cv::Mat sliver(16, 16, CV_32F, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
+  sliver.colRange(0, 3).setTo(20);
+  options.require_quadrants = false;
+  const fovea::BlockOptions whole{0, 4, true};
+  CHECK(fovea::FitBlocks(sliver, 16, options, whole, nullptr).size() == 1);
+  CHECK(fovea::FitBlocks(sliver, 16, options, whole, nullptr,
+                         fovea::BesideUnmatchedRuns(sliver, 3, 4))
+            .empty());
+}

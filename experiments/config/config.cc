@@ -280,6 +280,7 @@ void AddFovealParams(RunConfig* c, std::vector<ConfigParam>* params) {
                      {&fp::kFovealCoarseMarginPx, &x.foveal.coarse_margin_px},
                      {&fp::kFovealEdgeErosionPx, &x.foveal.edge_erosion_px},
                      {&fp::kFovealEdgeJumpPx, &x.foveal.edge_jump_px},
+                     {&fp::kFovealEdgeHolePx, &x.foveal.edge_hole_px},
                      {&fp::kFovealMinFillShare, &x.foveal.blocks.min_fill_share},
                      {&fp::kFovealMinBlockPx, &x.foveal.blocks.min_block_px},
                      {&fp::kFovealPeripheryMinBlockPx, &x.foveal.periphery_min_block_px},

@@ -23,6 +23,7 @@ void FovealOptions::Check() const {
   rig::CheckParam(params::kFovealSilentCheckLevel, silent_check_level);
   rig::CheckParam(params::kFovealEdgeErosionPx, edge_erosion_px);
   rig::CheckParam(params::kFovealEdgeJumpPx, edge_jump_px);
+  rig::CheckParam(params::kFovealEdgeHolePx, edge_hole_px);
   rig::CheckParam(params::kFovealMinFillShare, blocks.min_fill_share);
   rig::CheckParam(params::kFovealMinBlockPx, blocks.min_block_px);
   rig::CheckParam(params::kFovealPeripheryMinBlockPx, periphery_min_block_px);
@@ -286,6 +287,34 @@ int ErodeAtDisparityJumps(int radius, double jump_px, cv::Mat* disparity) {
   return n;
 }
 
+cv::Mat BesideUnmatchedRuns(const cv::Mat& disparity, int radius, int run_px) {
+  cv::Mat beside = cv::Mat::zeros(disparity.size(), CV_8U);
+  if (radius <= 0 || run_px <= 0) return beside;
+  for (const bool rows : {true, false}) {
+    const int lines = rows ? disparity.rows : disparity.cols;
+    const int length = rows ? disparity.cols : disparity.rows;
+    auto matched = [&](int line, int i) {
+      return std::isfinite(rows ? disparity.at<float>(line, i) : disparity.at<float>(i, line));
+    };
+    auto mark = [&](int line, int i) {
+      (rows ? beside.at<uchar>(line, i) : beside.at<uchar>(i, line)) = 1;
+    };
+    for (int line = 0; line < lines; ++line)
+      for (int i = 0; i < length;) {
+        if (matched(line, i)) {
+          ++i;
+          continue;
+        }
+        const int a = i;  // the run is [a, i)
+        while (i < length && !matched(line, i)) ++i;
+        if (i - a < run_px) continue;
+        for (int k = std::max(0, a - radius); k < a; ++k) mark(line, k);
+        for (int k = i; k < std::min(length, i + radius); ++k) mark(line, k);
+      }
+  }
+  return beside;
+}
+
 namespace {
 
 // The patch of one fitted block of a level: it spans the block's footprint
@@ -345,7 +374,9 @@ int LevelPatches(const rig::StereoFrame& frame, const Tessellation& t, const Lev
   if (level.index > 0)
     blocks.min_block_px = std::max(blocks.min_block_px, options.periphery_min_block_px);
   int added = 0;
-  for (const BlockFit& b : FitBlocks(disparity, size, fit_options, blocks, in_level))
+  const cv::Mat beside_holes =
+      BesideUnmatchedRuns(disparity, options.edge_erosion_px, options.edge_hole_px);
+  for (const BlockFit& b : FitBlocks(disparity, size, fit_options, blocks, in_level, beside_holes))
     if (const auto p = BlockPatch(frame, level, b, fixation)) {
       patches->Add(*p);
       ++added;

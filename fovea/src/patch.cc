@@ -114,11 +114,13 @@ std::optional<PlaneFit> FitDisparityPlane(const std::vector<DisparitySample>& sa
     ss += r * r;
     fit.max_abs_px = std::max(fit.max_abs_px, std::abs(r));
     quadrant[(s->x_px >= cx ? 1 : 0) + (s->y_px >= cy ? 2 : 0)] = true;
-    box = Eigen::Vector4d(std::min(box(0), s->x_px), std::min(box(1), s->y_px),
-                          std::max(box(2), s->x_px), std::max(box(3), s->y_px));
+    if (s->bounds)
+      box = Eigen::Vector4d(std::min(box(0), s->x_px), std::min(box(1), s->y_px),
+                            std::max(box(2), s->x_px), std::max(box(3), s->y_px));
   }
   if (options.require_quadrants && !(quadrant[0] && quadrant[1] && quadrant[2] && quadrant[3]))
     return std::nullopt;
+  if (inlier_box && box(0) > box(2)) return std::nullopt;  // no inlier bounds
   fit.support = static_cast<int>(inliers.size());
   fit.rms_px = std::sqrt(ss / fit.support);
   if (inlier_box) *inlier_box = box;
@@ -127,19 +129,23 @@ std::optional<PlaneFit> FitDisparityPlane(const std::vector<DisparitySample>& sa
 
 namespace {
 
-void FitBlock(const cv::Mat& disparity, int bx, int by, int size, const PlaneFitOptions& options,
-              const BlockOptions& blocks, std::vector<BlockFit>* out) {
+void FitBlock(const cv::Mat& disparity, const cv::Mat& unbounded, int bx, int by, int size,
+              const PlaneFitOptions& options, const BlockOptions& blocks,
+              std::vector<BlockFit>* out) {
   PlaneFitOptions o = options;
   o.min_support = std::min(options.min_support, (3 * size * size) / 4);
   std::vector<DisparitySample> samples;
   for (int y = by; y < std::min(by + size, disparity.rows); ++y)
     for (int x = bx; x < std::min(bx + size, disparity.cols); ++x) {
       const float d = disparity.at<float>(y, x);
-      if (std::isfinite(d)) samples.push_back({double(x), double(y), d});
+      if (std::isfinite(d))
+        samples.push_back(
+            {double(x), double(y), d, unbounded.empty() || unbounded.at<uchar>(y, x) == 0});
     }
   if (samples.empty()) return;
   Eigen::Vector4d box;
-  const auto fit = FitDisparityPlane(samples, bx, by, size, o, &box);
+  const auto fit =
+      FitDisparityPlane(samples, bx, by, size, o, blocks.clip_to_inliers ? &box : nullptr);
   // One plane for the whole block when its inliers fill it and it has next
   // to no outliers (measurements of another surface); else its quarters
   // are tried, and a smallest block that is not whole is left out.
@@ -159,18 +165,21 @@ void FitBlock(const cv::Mat& disparity, int bx, int by, int size, const PlaneFit
   const int half = size / 2;
   if (fill <= 0 || half < blocks.min_block_px) return;
   for (int q = 0; q < 4; ++q)
-    FitBlock(disparity, bx + (q % 2) * half, by + (q / 2) * half, half, options, blocks, out);
+    FitBlock(disparity, unbounded, bx + (q % 2) * half, by + (q / 2) * half, half, options, blocks,
+             out);
 }
 
 }  // namespace
 
 std::vector<BlockFit> FitBlocks(const cv::Mat& disparity, int size, const PlaneFitOptions& options,
                                 const BlockOptions& blocks,
-                                const std::function<bool(int x, int y, int size)>& keep) {
+                                const std::function<bool(int x, int y, int size)>& keep,
+                                const cv::Mat& unbounded) {
   std::vector<BlockFit> out;
   for (int by = 0; by + size <= disparity.rows; by += size)
     for (int bx = 0; bx + size <= disparity.cols; bx += size)
-      if (!keep || keep(bx, by, size)) FitBlock(disparity, bx, by, size, options, blocks, &out);
+      if (!keep || keep(bx, by, size))
+        FitBlock(disparity, unbounded, bx, by, size, options, blocks, &out);
   return out;
 }
 

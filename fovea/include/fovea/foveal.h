@@ -51,6 +51,13 @@ struct FovealOptions {
   /// farther one's pixels beside their edge); 0: none. A window's half width.
   int edge_erosion_px = 3;
   double edge_jump_px = 1.5;
+  /// Beyond the paper: matches within edge_erosion_px of a row or column run
+  /// of at least this many unmatched pixels do not set a patch's footprint
+  /// (they still count in its fit): beside an edge whose farther side goes
+  /// unmatched (outside the search band, or without texture) the window
+  /// still matches the nearer texture over the edge, and no farther match
+  /// shows the jump. 0: none; 7: a window's width at edge_erosion_px 3.
+  int edge_hole_px = 7;
   /// Beyond the paper: a block becomes one patch only if its inliers fill
   /// enough of it, else it is split into quarters, and a patch covers only
   /// its inliers' extent, so that no patch reaches over a depth edge or a
@@ -116,6 +123,11 @@ struct FovealResult {
 /// neighbours within `jump_px` of it; NaN pixels and isolated mismatches do
 /// not. Returns how many (FovealOptions::edge_erosion_px).
 int ErodeAtDisparityJumps(int radius, double jump_px, cv::Mat* disparity);
+
+/// The pixels (CV_8U, 1) within `radius` pixels, along a row or a column, of
+/// a run of at least `run_px` NaN pixels of `disparity` (CV_32F) on that
+/// line; all 0 if either is 0 (FovealOptions::edge_hole_px).
+cv::Mat BesideUnmatchedRuns(const cv::Mat& disparity, int radius, int run_px);
 
 /// Matches a verged pair that fixates p_W, level by level, coarse to fine,
 /// with the range at each pixel bounded by `map` (or by Z_T where the map is

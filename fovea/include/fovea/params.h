@@ -175,6 +175,13 @@ inline constexpr ParamSpec kFovealEdgeErosionPx{
     0, 10};
 inline constexpr ParamSpec kFovealEdgeJumpPx{
     "foveal.edge_jump_px", "see foveal.edge_erosion_px: the disparity jump, level pixels", 0.1, 64};
+inline constexpr ParamSpec kFovealEdgeHolePx{
+    "foveal.edge_hole_px",
+    "beyond the paper: matches within foveal.edge_erosion_px level pixels of a row or column run "
+    "of at least this many unmatched level pixels do not set a patch's footprint, though they "
+    "count in its fit (beside an edge whose farther side goes unmatched, out of the search band "
+    "or without texture, no farther match shows the jump; 0 = none)",
+    0, 64};
 inline constexpr ParamSpec kFovealMinFillShare{
     "foveal.min_fill_share",
     "beyond the paper: a block is one patch only if its inliers fill this share of it, else it is "

@@ -91,12 +91,16 @@ struct PlaneFitOptions {
 /// One measurement: a disparity at a (sub-pixel) image position.
 struct DisparitySample {
   double x_px, y_px, disparity_px;
+  /// Whether, as an inlier, it extends the fit's inlier box (false: a match
+  /// that counts in the fit but does not set the patch's footprint).
+  bool bounds = true;
 };
 
 /// Trimmed least-squares plane over the samples that fall in the block
 /// [x0, x0 + size) x [y0, y0 + size). nullopt if the block has too little
 /// support, degenerate geometry, or too many samples beyond the tolerance.
-/// `inlier_box`, if given, receives the inliers' extent (x0, y0, x1, y1).
+/// `inlier_box`, if given, receives the extent (x0, y0, x1, y1) of the
+/// inliers that bound (DisparitySample::bounds); nullopt if none does.
 std::optional<PlaneFit> FitDisparityPlane(const std::vector<DisparitySample>& samples, double x0,
                                           double y0, double size, const PlaneFitOptions& options,
                                           Eigen::Vector4d* inlier_box = nullptr);
@@ -129,10 +133,13 @@ struct BlockOptions {
 
 /// Planes over the blocks of `size` pixels that tile `disparity` (CV_32F,
 /// NaN = no measurement) that `keep` accepts, by the rules of `blocks`. The
-/// fit's min_support shrinks with the block (to 3/4 of its pixels).
+/// fit's min_support shrinks with the block (to 3/4 of its pixels). Where
+/// `unbounded` (CV_8U, same size, optional) is non-zero, a match counts in
+/// the fit but does not set a clipped footprint.
 std::vector<BlockFit> FitBlocks(const cv::Mat& disparity, int size, const PlaneFitOptions& options,
                                 const BlockOptions& blocks,
-                                const std::function<bool(int x, int y, int size)>& keep);
+                                const std::function<bool(int x, int y, int size)>& keep,
+                                const cv::Mat& unbounded = cv::Mat());
 
 /// Result of a ray query.
 struct PatchHit {
