@@ -5,6 +5,7 @@
 
 #include "fovea/patch.h"
 #include "scenes/catalog.h"
+#include "test_views.h"
 
 TEST_CASE("reference view: the strip past a near left edge is out of every right camera's sight",
           "[experiments][scoring][slow]") {
@@ -129,4 +130,49 @@ TEST_CASE("error picture: right pixels green, too near red, too far magenta, tru
   CHECK(at(31, 20) == cv::Vec3b(255, 80, 0));
   CHECK(at(32, 20) == cv::Vec3b(255, 80, 0));
   CHECK(at(30, 20) == right);
+}
+
+TEST_CASE("stale IDR patches: finer data at their surface over their whole footprint",
+          "[experiments][scoring]") {
+  const rig::CameraView view = ForwardView(320, 240, 300);  // at 1 m: x in +-0.533
+  // A square over x in [x0, x0 + s], z in [z0, z0 + s] at depth y.
+  auto square = [](double x0, double z0, double s, double y, fovea::PatchLevel level) {
+    fovea::Patch p;
+    p.corners_W = {Eigen::Vector3d(x0, y, z0), Eigen::Vector3d(x0 + s, y, z0),
+                   Eigen::Vector3d(x0 + s, y, z0 + s), Eigen::Vector3d(x0, y, z0 + s)};
+    p.level = level;
+    p.resolution_level = level == fovea::PatchLevel::kFoveal ? 0 : 1;
+    return p;
+  };
+  using L = fovea::PatchLevel;
+  fovea::PatchMap map;
+  map.Add(square(-0.3, 0.0, 0.1, 1.0, L::kIdr));  // 0: covered by two halves
+  map.Add(square(0.45, 0.0, 0.2, 1.0, L::kIdr));  // 1: 42% in view, all of that covered
+  map.Add(square(-0.1, 0.0, 0.1, 1.0, L::kIdr));  // 2: a nearer surface in front of it
+  map.Add(square(0.1, 0.0, 0.1, 1.0, L::kIdr));   // 3: a farther one behind it
+  map.Add(square(-0.3, 0.0, 0.05, 1.0, L::kFoveal));
+  map.Add(square(-0.25, 0.0, 0.05, 1.0, L::kFoveal));
+  map.Add(square(-0.3, 0.05, 0.1, 1.0, L::kPeripheral));
+  map.Add(square(0.4, -0.05, 0.3, 1.0, L::kPeripheral));
+  map.Add(square(-0.12, -0.02, 0.14, 0.8, L::kPeripheral));
+  map.Add(square(0.1, -0.05, 0.3, 1.6, L::kPeripheral));
+  std::vector<char> off(map.size(), 0);
+  CHECK(experiments::StaleIdrPatches(map, view, off) == 1);
+  // Off its own surface, the IDR patch under nearer finer data is stale too;
+  // finer data behind one never covers it.
+  off[2] = off[3] = 1;
+  CHECK(experiments::StaleIdrPatches(map, view, off) == 2);
+  // Moved wholly into view with its cover, the patch at the border is stale.
+  fovea::PatchMap inside;
+  for (size_t i = 0; i < map.size(); ++i) {
+    fovea::Patch p = map[i];
+    if (i == 1 || i == 7)
+      for (auto& c : p.corners_W) c.x() -= 0.15;
+    inside.Add(p);
+  }
+  CHECK(experiments::StaleIdrPatches(inside, view, off) == 3);
+  // Without finer patches nothing is stale.
+  fovea::PatchMap idr_only;
+  for (size_t i = 0; i < 4; ++i) idr_only.Add(map[i]);
+  CHECK(experiments::StaleIdrPatches(idr_only, view, {1, 1, 1, 1}) == 0);
 }

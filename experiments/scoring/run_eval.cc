@@ -1,12 +1,13 @@
 #include "experiments/scoring/run_eval.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <opencv2/imgproc.hpp>
 
 #include "fovea/geometry.h"
-#include "fovea/integration.h"
 #include "fovea/stats.h"
 #include "sim/sim_rig.h"
 
@@ -202,20 +203,131 @@ ReferenceView MakeReferenceView(rig::Rig& rig, sim::Simulation& sim) {
   return ref;
 }
 
-int StaleIdrPatches(const fovea::PatchMap& map, const rig::CameraView& view) {
-  const std::vector<char> covered = fovea::CoveredIdrPatches(map, {view}, kStaleCoveredShare);
-  return static_cast<int>(std::count(covered.begin(), covered.end(), 1));
+namespace {
+
+// The area of a simple polygon (shoelace formula), either orientation.
+double PolygonArea(const std::vector<Eigen::Vector2d>& p) {
+  double twice = 0;
+  for (size_t i = 0; i < p.size(); ++i) {
+    const Eigen::Vector2d& a = p[i];
+    const Eigen::Vector2d& b = p[(i + 1) % p.size()];
+    twice += a.x() * b.y() - b.x() * a.y();
+  }
+  return 0.5 * std::abs(twice);
+}
+
+// A convex polygon clipped to the box [lo, hi] (Sutherland-Hodgman: one
+// edge of the box at a time).
+std::vector<Eigen::Vector2d> ClipToBox(std::vector<Eigen::Vector2d> p, const Eigen::Vector2d& lo,
+                                       const Eigen::Vector2d& hi) {
+  for (int axis = 0; axis < 2; ++axis)
+    for (const double sign : {1.0, -1.0}) {
+      // Keep the points with sign * (x[axis] - bound) >= 0.
+      const double bound = sign > 0 ? lo[axis] : hi[axis];
+      auto inside = [&](const Eigen::Vector2d& q) { return sign * (q[axis] - bound) >= 0; };
+      std::vector<Eigen::Vector2d> out;
+      for (size_t i = 0; i < p.size(); ++i) {
+        const Eigen::Vector2d& a = p[i];
+        const Eigen::Vector2d& b = p[(i + 1) % p.size()];
+        if (inside(a)) out.push_back(a);
+        if (inside(a) != inside(b))
+          out.push_back(a + (b - a) * ((bound - a[axis]) / (b[axis] - a[axis])));
+      }
+      p = std::move(out);
+    }
+  return p;
+}
+
+}  // namespace
+
+int StaleIdrPatches(const fovea::PatchMap& map, const rig::CameraView& view,
+                    const std::vector<char>& off_surface) {
+  fovea::PatchMap idr, finer;
+  std::vector<size_t> idr_index;  // map index of each IDR patch
+  for (size_t i = 0; i < map.size(); ++i) {
+    if (map[i].level == fovea::PatchLevel::kIdr) {
+      idr.Add(map[i]);
+      idr_index.push_back(i);
+    } else {
+      finer.Add(map[i]);
+    }
+  }
+  if (idr.size() == 0 || finer.size() == 0) return 0;
+  cv::Mat idr_depth, idr_ids, finer_depth, finer_ids;
+  idr.Render(view.world_T_camera, view.intrinsics, &idr_depth, &idr_ids);
+  finer.Render(view.world_T_camera, view.intrinsics, &finer_depth, &finer_ids);
+  std::vector<long> shown(idr.size(), 0), covered(idr.size(), 0);
+  for (int y = 0; y < idr_ids.rows; ++y)
+    for (int x = 0; x < idr_ids.cols; ++x) {
+      const int id = idr_ids.at<int>(y, x);
+      if (id < 0) continue;
+      ++shown[id];
+      const int f = finer_ids.at<int>(y, x);
+      if (f < 0) continue;
+      const double zi = idr_depth.at<float>(y, x), zf = finer_depth.at<float>(y, x);
+      covered[id] += fovea::PatchMap::SameSurface(zi, idr[id], zf, finer[f]) ||
+                     (zf <= zi && off_surface.at(idr_index[id]));
+    }
+  const Eigen::Isometry3d camera_T_world = view.world_T_camera.inverse();
+  const rig::CameraIntrinsics& k = view.intrinsics;
+  int stale = 0;
+  for (size_t id = 0; id < idr.size(); ++id) {
+    if (shown[id] == 0) continue;
+    // The part of the footprint past the image's border counts as not
+    // covered: a sliver in view says nothing of the rest.
+    std::vector<Eigen::Vector2d> quad;
+    for (const Eigen::Vector3d& c : idr[id].corners_W) {
+      const Eigen::Vector3d p_C = camera_T_world * c;
+      if (p_C.z() <= 0) break;
+      quad.push_back(k.Project(p_C));
+    }
+    if (quad.size() != 4) continue;
+    const double outside =
+        PolygonArea(quad) -
+        PolygonArea(ClipToBox(quad, {-0.5, -0.5}, {k.width_px - 0.5, k.height_px - 0.5}));
+    const double footprint = shown[id] + std::max(0.0, outside);
+    stale += covered[id] >= kStaleCoveredShare * footprint;
+  }
+  return stale;
 }
 
 namespace {
 
 // Each patch's 3D error: the distance from its centre to the true surface
 // along its normal (either way); and the IDR patches finer data has made stale.
+// Whether a patch lies more than kBadShare of its depth in `view` from the
+// true surface at its centre or at one of its corners, measured along the
+// view's line of sight through the point, either way: the nearest surface
+// along that line, as if nothing stood in front (a patch the view sees
+// behind a nearer surface is judged on its own). A slant far off the
+// surface's shows at the corners, where the distance along the patch's
+// normal from its centre does not.
+bool OffSurface(const fovea::Patch& p, const rig::CameraView& view, const sim::GroundTruth& truth) {
+  const Eigen::Vector3d origin = view.world_T_camera.translation();
+  const Eigen::Vector3d axis = view.world_T_camera.linear().col(2);
+  std::array<Eigen::Vector3d, 5> points;
+  std::copy(p.corners_W.begin(), p.corners_W.end(), points.begin());
+  points[4] = p.Centre();
+  for (const Eigen::Vector3d& q : points) {
+    const Eigen::Vector3d line = (q - origin).normalized();
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const double sign : {1.0, -1.0})
+      if (const auto hit = truth.CastRay(q, sign * line))
+        nearest = std::min(nearest, hit->distance_m);
+    if (!(nearest <= kBadShare * std::abs((q - origin).dot(axis)))) return true;
+  }
+  return false;
+}
+
 void ScorePatches(const fovea::PatchMap& map, const rig::CameraView& view,
                   const sim::GroundTruth& truth, MapScore* s) {
   s->has_patch_error = true;
   std::vector<double> err;
-  for (const fovea::Patch& p : map.patches()) {
+  // IDR patches more than kBadShare of their depth off their true surface
+  // somewhere (OffSurface).
+  std::vector<char> off_surface(map.size(), 0);
+  for (size_t i = 0; i < map.size(); ++i) {
+    const fovea::Patch& p = map[i];
     const Eigen::Vector3d c = p.Centre(), n = p.Normal();
     double best = std::numeric_limits<double>::infinity();
     for (const double sign : {1.0, -1.0}) {
@@ -223,11 +335,12 @@ void ScorePatches(const fovea::PatchMap& map, const rig::CameraView& view,
       if (hit) best = std::min(best, hit->distance_m);
     }
     if (std::isfinite(best)) err.push_back(best);
+    off_surface[i] = p.level == fovea::PatchLevel::kIdr && OffSurface(p, view, truth);
   }
   s->patches_scored = static_cast<int>(err.size());
   s->patch_error_median_m = Quantile(err, 0.5);
   s->patch_error_p90_m = Quantile(err, 0.9);
-  s->stale_idr_patches = StaleIdrPatches(map, view);
+  s->stale_idr_patches = StaleIdrPatches(map, view, off_surface);
 }
 
 }  // namespace

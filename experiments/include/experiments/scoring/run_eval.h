@@ -111,19 +111,27 @@ struct MapScore {
   bool has_patch_error = false;
   double patch_error_median_m = 0, patch_error_p90_m = 0;
   int patches_scored = 0;
-  /// With the per-patch figures: IDR patches whose footprint in the reference
-  /// view finer (peripheral or foveal) patches cover, at least
-  /// kStaleCoveredShare of it, at the IDR patch's surface or in front of it
-  /// (fovea::CoveredIdrPatches): coarse data the replacement rule should
-  /// have removed.
+  /// With the per-patch figures: IDR patches that finer (peripheral or
+  /// foveal) patches cover in the reference view, at least kStaleCoveredShare
+  /// of their whole footprint, at the IDR patch's surface (or, for an IDR
+  /// patch off its true surface, also in front of it): coarse data the
+  /// replacement rule should have removed (StaleIdrPatches).
   int stale_idr_patches = 0;
 };
 
 inline constexpr double kStaleCoveredShare = 0.9;
 
-/// The IDR patches of `map` whose footprint in `view` its finer patches
-/// cover (MapScore::stale_idr_patches).
-int StaleIdrPatches(const fovea::PatchMap& map, const rig::CameraView& view);
+/// How many IDR patches of `map` its finer patches cover in `view`
+/// (MapScore::stale_idr_patches): at least kStaleCoveredShare of the patch's
+/// whole footprint (the projected quad; a part past the image's border or
+/// hidden by another IDR patch counts as not covered) shows finer patches at
+/// the IDR patch's surface (PatchMap::SameSurface), or, where
+/// off_surface[i] (indexed like `map`) says the IDR patch lies off its true
+/// surface, at its surface or in front of it. In front of an IDR patch on its
+/// true surface a nearer surface's patches hide it in this view; they do not
+/// measure it.
+int StaleIdrPatches(const fovea::PatchMap& map, const rig::CameraView& view,
+                    const std::vector<char>& off_surface);
 
 /// Where `map` is right and wrong in the reference view (BGR, the view's
 /// size): the reference image dimmed; the mapped textured pixels (those the
