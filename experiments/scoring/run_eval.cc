@@ -1,7 +1,6 @@
 #include "experiments/scoring/run_eval.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -295,36 +294,28 @@ namespace {
 
 // Each patch's 3D error: the distance from its centre to the true surface
 // along its normal (either way); and the IDR patches finer data has made stale.
-// Whether a patch lies more than kBadShare of its depth in `view` from the
-// true surface at its centre or at one of its corners, measured along the
-// view's line of sight through the point, either way: the nearest surface
-// along that line, as if nothing stood in front (a patch the view sees
-// behind a nearer surface is judged on its own). A slant far off the
-// surface's shows at the corners, where the distance along the patch's
-// normal from its centre does not.
+// Whether a patch's centre lies more than kBadShare of its depth in `view`
+// from the true surface, measured along the view's line of sight through
+// it, either way: the nearest surface along that line, as if nothing stood
+// in front (a patch the view sees behind a nearer surface is judged on its
+// own).
 bool OffSurface(const fovea::Patch& p, const rig::CameraView& view, const sim::GroundTruth& truth) {
   const Eigen::Vector3d origin = view.world_T_camera.translation();
   const Eigen::Vector3d axis = view.world_T_camera.linear().col(2);
-  std::array<Eigen::Vector3d, 5> points;
-  std::copy(p.corners_W.begin(), p.corners_W.end(), points.begin());
-  points[4] = p.Centre();
-  for (const Eigen::Vector3d& q : points) {
-    const Eigen::Vector3d line = (q - origin).normalized();
-    double nearest = std::numeric_limits<double>::infinity();
-    for (const double sign : {1.0, -1.0})
-      if (const auto hit = truth.CastRay(q, sign * line))
-        nearest = std::min(nearest, hit->distance_m);
-    if (!(nearest <= kBadShare * std::abs((q - origin).dot(axis)))) return true;
-  }
-  return false;
+  const Eigen::Vector3d c = p.Centre(), line = (c - origin).normalized();
+  double nearest = std::numeric_limits<double>::infinity();
+  for (const double sign : {1.0, -1.0})
+    if (const auto hit = truth.CastRay(c, sign * line))
+      nearest = std::min(nearest, hit->distance_m);
+  return !(nearest <= kBadShare * std::abs((c - origin).dot(axis)));
 }
 
 void ScorePatches(const fovea::PatchMap& map, const rig::CameraView& view,
                   const sim::GroundTruth& truth, MapScore* s) {
   s->has_patch_error = true;
   std::vector<double> err;
-  // IDR patches more than kBadShare of their depth off their true surface
-  // somewhere (OffSurface).
+  // IDR patches whose centre is more than kBadShare of its depth off the
+  // true surface (OffSurface).
   std::vector<char> off_surface(map.size(), 0);
   for (size_t i = 0; i < map.size(); ++i) {
     const fovea::Patch& p = map[i];

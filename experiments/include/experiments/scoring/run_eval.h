@@ -126,10 +126,10 @@ inline constexpr double kStaleCoveredShare = 0.9;
 /// whole footprint (the projected quad; a part past the image's border or
 /// hidden by another IDR patch counts as not covered) shows finer patches at
 /// the IDR patch's surface (PatchMap::SameSurface), or, where
-/// off_surface[i] (indexed like `map`) says the IDR patch lies off its true
-/// surface, at its surface or in front of it. In front of an IDR patch on its
-/// true surface a nearer surface's patches hide it in this view; they do not
-/// measure it.
+/// off_surface[i] (indexed like `map`) says the IDR patch's centre lies off
+/// its true surface, at its surface or in front of it. In front of an IDR
+/// patch on its true surface a nearer surface's patches hide it in this
+/// view; they do not measure it.
 int StaleIdrPatches(const fovea::PatchMap& map, const rig::CameraView& view,
                     const std::vector<char>& off_surface);
 
