@@ -294,6 +294,39 @@ TEST_CASE("the fovea has a floor of foveal.min_fovea_px, and the levels stay nes
     CHECK((t.rects[level] & t.rects[level - 1]) == t.rects[level - 1]);
 }
 
+TEST_CASE("every level's rectangle is the largest centred one its threshold allows",
+          "[fovea][tessellation]") {
+  // The paper's 4 levels on a tilted verged pair, where the levels differ:
+  // each level but the last against a brute-force scan of every pixel (the
+  // library visits only the pixels that can narrow a level).
+  for (const double elevation_deg : {0.0, 20.0}) {
+    const Eigen::Vector3d fixation = AtElevation(0.6, elevation_deg);
+    const Pair pair = Verged(fixation, 0.12);
+    const double z0 = (pair.left.world_T_camera.inverse() * fixation).z();
+    fovea::TessellationOptions paper;
+    paper.min_fovea_px = 0;
+    paper.max_levels = 4;
+    const fovea::Tessellation t = fovea::Tessellate(pair.left, pair.right, fixation, {}, paper);
+    const auto& k = pair.left.intrinsics;
+    std::vector<double> worst(k.width_px * k.height_px);
+    for (int v = 0; v < k.height_px; ++v)
+      for (int u = 0; u < k.width_px; ++u)
+        worst[v * k.width_px + u] = BruteVerticalDisparity(pair, z0, u, v);
+    REQUIRE(t.rects.size() >= 3);
+    for (size_t level = 0; level + 1 < t.rects.size(); ++level) {
+      double scale = 1;
+      for (int v = 0; v < k.height_px; ++v)
+        for (int u = 0; u < k.width_px; ++u)
+          if (worst[v * k.width_px + u] >= 0.5 * std::pow(2.0, level))
+            scale = std::min(scale, std::max(std::abs(u - k.cx_px) / (0.5 * k.width_px),
+                                             std::abs(v - k.cy_px) / (0.5 * k.height_px)));
+      INFO("elevation " << elevation_deg << " level " << level << " rect " << t.rects[level]);
+      CHECK(t.rects[level].width == Approx(scale * k.width_px).margin(2.0));
+      CHECK(t.rects[level].height == Approx(scale * k.height_px).margin(2.0));
+    }
+  }
+}
+
 TEST_CASE("the parallel frame turns a pair with turned mounts and differing intrinsics into rows",
           "[fovea][fixation_frame]") {
   // IDR's pair on an imperfect rig: both cameras pointed straight ahead

@@ -137,7 +137,6 @@ void RecordFixation(const FixationResult& r, FixationRecord* rec) {
   rec->placement = r.placement;
   rec->baseline_m = r.baseline_m;
   rec->tessellation = r.foveal.tessellation;
-  rec->tessellation.vertical_disparity_px.release();
   rec->tessellation.mask.release();
   rec->fovea = r.foveal.Fovea();
   rec->levels = r.foveal.levels;

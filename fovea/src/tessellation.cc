@@ -20,27 +20,6 @@ int Tessellation::LevelAt(int u, int v) const {
   return static_cast<int>(rects.size()) - 1;
 }
 
-cv::Mat VerticalDisparity(const rig::CameraView& left, const rig::CameraView& right,
-                          const std::vector<double>& depths) {
-  const rig::CameraIntrinsics& kl = left.intrinsics;
-  const rig::CameraIntrinsics& kr = right.intrinsics;
-  const Eigen::Isometry3d right_T_left = right.world_T_camera.inverse() * left.world_T_camera;
-  cv::Mat out(kl.height_px, kl.width_px, CV_32F, cv::Scalar(0));
-  for (int v = 0; v < kl.height_px; ++v) {
-    float* row = out.ptr<float>(v);
-    for (int u = 0; u < kl.width_px; ++u) {
-      const Eigen::Vector3d ray = kl.Ray({u, v});  // z = 1
-      for (double z : depths) {
-        const Eigen::Vector3d p_R = right_T_left * (z * ray);
-        if (p_R.z() <= 0) continue;
-        const double vr = kr.fy_px * p_R.y() / p_R.z() + kr.cy_px;
-        row[u] = std::max(row[u], static_cast<float>(std::abs(vr - v)));
-      }
-    }
-  }
-  return out;
-}
-
 double AxisHorizontalDisparity(const rig::CameraView& left, const rig::CameraView& right,
                                double z) {
   const Eigen::Vector3d p_W = left.world_T_camera * Eigen::Vector3d(0, 0, z);
@@ -49,6 +28,59 @@ double AxisHorizontalDisparity(const rig::CameraView& left, const rig::CameraVie
 }
 
 namespace {
+
+// Worst-case |vertical disparity| of left pixel (u, v), px: over the points
+// where its ray meets the left-camera fronto-parallel planes at `depths`,
+// by real projection into the right camera.
+float PixelVerticalDisparity(const rig::CameraIntrinsics& kl, const rig::CameraIntrinsics& kr,
+                             const Eigen::Isometry3d& right_T_left,
+                             const std::vector<double>& depths, int u, int v) {
+  float worst = 0;
+  const Eigen::Vector3d ray = kl.Ray({u, v});  // z = 1
+  for (double z : depths) {
+    const Eigen::Vector3d p_R = right_T_left * (z * ray);
+    if (p_R.z() <= 0) continue;
+    const double vr = kr.fy_px * p_R.y() / p_R.z() + kr.cy_px;
+    worst = std::max(worst, static_cast<float>(std::abs(vr - v)));
+  }
+  return worst;
+}
+
+// Per threshold, the smallest ring max(|u - cx| / hw, |v - cy| / hh) of a
+// left pixel whose worst |vertical disparity| reaches it, 1 if none: the
+// scale of the largest centred rectangle of the image's shape that excludes
+// every such pixel. Vertical disparity is only computed where it can lower
+// a scale: a grid every kGridPx pixels bounds the scales from above, then
+// only the pixels within the largest bound's ring are visited. The same
+// minimum as a visit of every pixel: a pixel outside the bound's ring
+// cannot lower it, and the bound is itself a violating pixel's ring.
+std::vector<double> ViolationScales(const rig::CameraView& left, const rig::CameraView& right,
+                                    const std::vector<double>& depths,
+                                    const std::vector<float>& thresholds) {
+  constexpr int kGridPx = 8;
+  const rig::CameraIntrinsics& k = left.intrinsics;
+  const Eigen::Isometry3d right_T_left = right.world_T_camera.inverse() * left.world_T_camera;
+  const double cx = k.cx_px, cy = k.cy_px, hw = 0.5 * k.width_px, hh = 0.5 * k.height_px;
+  std::vector<double> scales(thresholds.size(), 1.0);
+  if (thresholds.empty()) return scales;
+  auto visit = [&](int u, int v, double ring) {
+    const float worst = PixelVerticalDisparity(k, right.intrinsics, right_T_left, depths, u, v);
+    for (size_t i = 0; i < thresholds.size(); ++i)
+      if (worst >= thresholds[i]) scales[i] = std::min(scales[i], ring);
+  };
+  auto ring = [&](int u, int v) { return std::max(std::abs(u - cx) / hw, std::abs(v - cy) / hh); };
+  for (int v = 0; v < k.height_px; v += kGridPx)
+    for (int u = 0; u < k.width_px; u += kGridPx) visit(u, v, ring(u, v));
+  const double bound = *std::max_element(scales.begin(), scales.end());
+  const int u0 = std::max(0, static_cast<int>(std::floor(cx - bound * hw)) - 1),
+            u1 = std::min(k.width_px - 1, static_cast<int>(std::ceil(cx + bound * hw)) + 1),
+            v0 = std::max(0, static_cast<int>(std::floor(cy - bound * hh)) - 1),
+            v1 = std::min(k.height_px - 1, static_cast<int>(std::ceil(cy + bound * hh)) + 1);
+  for (int v = v0; v <= v1; ++v)
+    for (int u = u0; u <= u1; ++u)
+      if (const double r = ring(u, v); r <= bound) visit(u, v, r);
+  return scales;
+}
 
 // `r` grown, centred on the principal point, to at least `size` pixels wide
 // and high (within the image).
@@ -114,21 +146,17 @@ Tessellation TessellateFromDepth(const rig::CameraView& left, const rig::CameraV
       t.z_max_far_m = std::max(t.z_max_far_m, off);
       t.z_max_near_m = std::max(t.z_max_near_m, -off);
     }
-  t.vertical_disparity_px =
-      VerticalDisparity(left, right, {z0 - t.z_max_near_m, z0, z0 + t.z_max_far_m});
-
   // Level k holds where |vertical disparity| < 0.5 * 2^k: the largest centred
-  // rectangle of the image's shape that excludes every violating pixel.
+  // rectangle of the image's shape that excludes every violating pixel. The
+  // last level is the whole image: its threshold is not needed.
+  std::vector<float> thresholds;
+  for (int level = 0; level + 1 < options.max_levels; ++level)
+    thresholds.push_back(static_cast<float>(0.5 * std::pow(2.0, level)));
+  const std::vector<double> scales =
+      ViolationScales(left, right, {z0 - t.z_max_near_m, z0, z0 + t.z_max_far_m}, thresholds);
   const double cx = k.cx_px, cy = k.cy_px, hw = 0.5 * k.width_px, hh = 0.5 * k.height_px;
   for (int level = 0; level < options.max_levels; ++level) {
-    const float threshold = static_cast<float>(0.5 * std::pow(2.0, level));
-    double scale = 1.0;
-    for (int v = 0; v < k.height_px; ++v) {
-      const float* row = t.vertical_disparity_px.ptr<float>(v);
-      for (int u = 0; u < k.width_px; ++u)
-        if (row[u] >= threshold)
-          scale = std::min(scale, std::max(std::abs(u - cx) / hw, std::abs(v - cy) / hh));
-    }
+    double scale = level < static_cast<int>(scales.size()) ? scales[level] : 1.0;
     const bool last = level + 1 == options.max_levels || scale >= 1.0;
     if (last) scale = 1.0;
     // Pixels strictly inside |u - cx| < scale hw, |v - cy| < scale hh.

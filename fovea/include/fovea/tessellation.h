@@ -37,8 +37,6 @@ struct Tessellation {
   /// Per level k: the centred rectangle (full-resolution pixels) inside
   /// which level k applies; level 0 innermost, the last one the whole image.
   std::vector<cv::Rect> rects;
-  /// Worst-case |vertical disparity| per left pixel, px (CV_32F).
-  cv::Mat vertical_disparity_px;
   /// CV_8U: 255 where matching may run, 0 where the map puts the surface
   /// beyond Z_T of the fixation.
   cv::Mat mask;
@@ -46,12 +44,6 @@ struct Tessellation {
   /// The finest level whose rectangle contains the pixel.
   int LevelAt(int u, int v) const;
 };
-
-/// Worst-case |vertical disparity| per left pixel for points on the left-camera
-/// fronto-parallel planes at the given depths (max over the planes), by real
-/// projection into the right camera.
-cv::Mat VerticalDisparity(const rig::CameraView& left, const rig::CameraView& right,
-                          const std::vector<double>& plane_depths_m);
 
 /// Horizontal disparity (u_right - cx_right) of the point on the left
 /// optical axis at depth z_m.
