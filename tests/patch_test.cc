@@ -136,6 +136,39 @@ TEST_CASE("patch map: rendering into a view gives depth and patch ids", "[fovea]
     }
 }
 
+TEST_CASE("patch map: a render of a region equals the whole render there, empty elsewhere",
+          "[fovea][patch]") {
+  fovea::PatchMap map;
+  map.Add(Square(2.0, 0.5));
+  map.Add(Square(1.0, 0.1));
+  map.Add(Square(1.02, 0.3));  // the same surface as the near patch, about it
+  const auto k = rig::CameraIntrinsics::FromHorizontalFov(200, 150, 1.0);
+  cv::Mat depth, ids;
+  map.Render(Eigen::Isometry3d::Identity(), k, &depth, &ids);
+  // Regions across the patches' edges, one reaching past the image.
+  for (const cv::Rect region : {cv::Rect(80, 60, 30, 20), cv::Rect(150, 100, 80, 80)}) {
+    cv::Mat region_depth, region_ids;
+    map.Render(Eigen::Isometry3d::Identity(), k, &region_depth, &region_ids, region);
+    REQUIRE(region_depth.size() == depth.size());
+    const cv::Rect inside = region & cv::Rect(0, 0, 200, 150);
+    int differ = 0, drawn_outside = 0, set = 0;
+    for (int v = 0; v < 150; ++v)
+      for (int u = 0; u < 200; ++u) {
+        if (inside.contains({u, v})) {
+          differ += region_depth.at<float>(v, u) != depth.at<float>(v, u) ||
+                    region_ids.at<int>(v, u) != ids.at<int>(v, u);
+          set += region_ids.at<int>(v, u) >= 0;
+        } else {
+          drawn_outside += region_depth.at<float>(v, u) != 0 || region_ids.at<int>(v, u) != -1;
+        }
+      }
+    INFO("region " << region);
+    CHECK(differ == 0);
+    CHECK(drawn_outside == 0);
+    CHECK(set > 0);
+  }
+}
+
 TEST_CASE("blocks across a depth step split instead of bridging it", "[fovea][patch]") {
   // A 64 x 64 disparity image: 10 px left of x = 37, 20 px right of it
   // (noise 0.1 px), except a 4 px strip left of the step where matching

@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cmath>
+#include <opencv2/imgproc.hpp>
 #include <utility>
 #include <vector>
 
@@ -247,7 +248,10 @@ std::vector<char> CoveredIdrPatches(const PatchMap& map, const std::vector<rig::
   for (const rig::CameraView& view : views) {
     cv::Mat idr_depth, idr_ids, finer_depth, finer_ids;
     idr.Render(view.world_T_camera, view.intrinsics, &idr_depth, &idr_ids);
-    finer.Render(view.world_T_camera, view.intrinsics, &finer_depth, &finer_ids);
+    // The finer patches are read only where an IDR patch is seen.
+    const cv::Rect seen = cv::boundingRect(idr_ids >= 0);
+    if (seen.empty()) continue;
+    finer.Render(view.world_T_camera, view.intrinsics, &finer_depth, &finer_ids, seen);
     std::vector<long> footprint(idr.size(), 0), covered(idr.size(), 0);
     for (int y = 0; y < idr_ids.rows; ++y)
       for (int x = 0; x < idr_ids.cols; ++x)

@@ -375,7 +375,11 @@ std::optional<PatchHit> PatchMap::CastRayBruteForce(const Eigen::Vector3d& origi
 }
 
 void PatchMap::Render(const Eigen::Isometry3d& world_T_camera, const rig::CameraIntrinsics& k,
-                      cv::Mat* depth_m, cv::Mat* patch_ids) const {
+                      cv::Mat* depth_m, cv::Mat* patch_ids, const cv::Rect& region) const {
+  // The pixels drawn: the region within the image (the whole image when
+  // the region is empty).
+  const cv::Rect image(0, 0, k.width_px, k.height_px);
+  const cv::Rect drawn = region.empty() ? image : region & image;
   cv::Mat depth(k.height_px, k.width_px, CV_32F, cv::Scalar(0));
   cv::Mat ids(k.height_px, k.width_px, CV_32S, cv::Scalar(-1));
   const Eigen::Isometry3d camera_T_world = world_T_camera.inverse();
@@ -400,15 +404,15 @@ void PatchMap::Render(const Eigen::Isometry3d& world_T_camera, const rig::Camera
       const double area =
           (uv[1] - uv[0]).x() * (uv[2] - uv[0]).y() - (uv[1] - uv[0]).y() * (uv[2] - uv[0]).x();
       if (std::abs(area) < 1e-12) continue;
-      const int u0 =
-          std::max(0, static_cast<int>(std::ceil(std::min({uv[0].x(), uv[1].x(), uv[2].x()}))));
+      const int u0 = std::max(
+          drawn.x, static_cast<int>(std::ceil(std::min({uv[0].x(), uv[1].x(), uv[2].x()}))));
       const int u1 =
-          std::min(k.width_px - 1,
+          std::min(drawn.x + drawn.width - 1,
                    static_cast<int>(std::floor(std::max({uv[0].x(), uv[1].x(), uv[2].x()}))));
-      const int v0 =
-          std::max(0, static_cast<int>(std::ceil(std::min({uv[0].y(), uv[1].y(), uv[2].y()}))));
+      const int v0 = std::max(
+          drawn.y, static_cast<int>(std::ceil(std::min({uv[0].y(), uv[1].y(), uv[2].y()}))));
       const int v1 =
-          std::min(k.height_px - 1,
+          std::min(drawn.y + drawn.height - 1,
                    static_cast<int>(std::floor(std::max({uv[0].y(), uv[1].y(), uv[2].y()}))));
       for (int v = v0; v <= v1; ++v) {
         for (int u = u0; u <= u1; ++u) {

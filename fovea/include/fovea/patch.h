@@ -193,9 +193,11 @@ class PatchMap {
   /// the index of the patch seen per pixel (CV_32S, -1 where none), by
   /// z-buffered rasterization of every patch in front of the camera. Where
   /// patches are of the same surface (SameSurface), the one of the finest
-  /// level is seen (finer data supersedes coarser), else the nearest.
+  /// level is seen (finer data supersedes coarser), else the nearest. With a
+  /// non-empty `region`, only its pixels are drawn (the same values there as
+  /// the whole image's render; 0 and -1 elsewhere).
   void Render(const Eigen::Isometry3d& world_T_camera, const rig::CameraIntrinsics& intrinsics,
-              cv::Mat* depth_m, cv::Mat* patch_ids) const;
+              cv::Mat* depth_m, cv::Mat* patch_ids, const cv::Rect& region = {}) const;
 
   /// Builds the index now if the map changed since it was last built.
   void BuildIndex() const;
