@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "fovea/geometry.h"
+#include "fovea/integration.h"
 #include "fovea/stats.h"
 #include "sim/sim_rig.h"
 
@@ -241,42 +242,17 @@ std::vector<Eigen::Vector2d> ClipToBox(std::vector<Eigen::Vector2d> p, const Eig
 
 int StaleIdrPatches(const fovea::PatchMap& map, const rig::CameraView& view,
                     const std::vector<char>& off_surface) {
-  fovea::PatchMap idr, finer;
-  std::vector<size_t> idr_index;  // map index of each IDR patch
-  for (size_t i = 0; i < map.size(); ++i) {
-    if (map[i].level == fovea::PatchLevel::kIdr) {
-      idr.Add(map[i]);
-      idr_index.push_back(i);
-    } else {
-      finer.Add(map[i]);
-    }
-  }
-  if (idr.size() == 0 || finer.size() == 0) return 0;
-  cv::Mat idr_depth, idr_ids, finer_depth, finer_ids;
-  idr.Render(view.world_T_camera, view.intrinsics, &idr_depth, &idr_ids);
-  finer.Render(view.world_T_camera, view.intrinsics, &finer_depth, &finer_ids);
-  std::vector<long> shown(idr.size(), 0), covered(idr.size(), 0);
-  for (int y = 0; y < idr_ids.rows; ++y)
-    for (int x = 0; x < idr_ids.cols; ++x) {
-      const int id = idr_ids.at<int>(y, x);
-      if (id < 0) continue;
-      ++shown[id];
-      const int f = finer_ids.at<int>(y, x);
-      if (f < 0) continue;
-      const double zi = idr_depth.at<float>(y, x), zf = finer_depth.at<float>(y, x);
-      covered[id] += fovea::PatchMap::SameSurface(zi, idr[id], zf, finer[f]) ||
-                     (zf <= zi && off_surface.at(idr_index[id]));
-    }
   const Eigen::Isometry3d camera_T_world = view.world_T_camera.inverse();
   const rig::CameraIntrinsics& k = view.intrinsics;
   int stale = 0;
-  for (size_t id = 0; id < idr.size(); ++id) {
-    if (shown[id] == 0) continue;
+  const std::vector<std::vector<fovea::IdrCover>> coverage = fovea::IdrCoverage(map, {view});
+  for (const fovea::IdrCover& c : coverage.front()) {
+    if (c.shown == 0) continue;
     // The part of the footprint past the image's border counts as not
     // covered: a sliver in view says nothing of the rest.
     std::vector<Eigen::Vector2d> quad;
-    for (const Eigen::Vector3d& c : idr[id].corners_W) {
-      const Eigen::Vector3d p_C = camera_T_world * c;
+    for (const Eigen::Vector3d& corner : map[c.index].corners_W) {
+      const Eigen::Vector3d p_C = camera_T_world * corner;
       if (p_C.z() <= 0) break;
       quad.push_back(k.Project(p_C));
     }
@@ -284,16 +260,15 @@ int StaleIdrPatches(const fovea::PatchMap& map, const rig::CameraView& view,
     const double outside =
         PolygonArea(quad) -
         PolygonArea(ClipToBox(quad, {-0.5, -0.5}, {k.width_px - 0.5, k.height_px - 0.5}));
-    const double footprint = shown[id] + std::max(0.0, outside);
-    stale += covered[id] >= kStaleCoveredShare * footprint;
+    const double footprint = c.shown + std::max(0.0, outside);
+    const long covered = c.same_surface + (off_surface.at(c.index) ? c.in_front : 0);
+    stale += covered >= kStaleCoveredShare * footprint;
   }
   return stale;
 }
 
 namespace {
 
-// Each patch's 3D error: the distance from its centre to the true surface
-// along its normal (either way); and the IDR patches finer data has made stale.
 // Whether a patch's centre lies more than kBadShare of its depth in `view`
 // from the true surface, measured along the view's line of sight through
 // it, either way: the nearest surface along that line, as if nothing stood
@@ -310,6 +285,8 @@ bool OffSurface(const fovea::Patch& p, const rig::CameraView& view, const sim::G
   return !(nearest <= kBadShare * std::abs((c - origin).dot(axis)));
 }
 
+// Each patch's 3D error: the distance from its centre to the true surface
+// along its normal (either way); and the IDR patches finer data has made stale.
 void ScorePatches(const fovea::PatchMap& map, const rig::CameraView& view,
                   const sim::GroundTruth& truth, MapScore* s) {
   s->has_patch_error = true;

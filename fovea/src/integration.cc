@@ -231,43 +231,54 @@ IntegrationStats Integrate(PatchMap* map, const PatchMap& fresh_in, const rig::C
   return stats;
 }
 
-std::vector<char> CoveredIdrPatches(const PatchMap& map, const std::vector<rig::CameraView>& views,
-                                    double share) {
-  std::vector<char> covered_idr(map.size(), 0);
+std::vector<std::vector<IdrCover>> IdrCoverage(const PatchMap& map,
+                                               const std::vector<rig::CameraView>& views) {
   PatchMap idr, finer;
-  std::vector<size_t> idr_index;  // map index of each IDR patch
+  std::vector<IdrCover> none;  // one per IDR patch, nothing counted
   for (size_t i = 0; i < map.size(); ++i) {
     if (map[i].level == PatchLevel::kIdr) {
       idr.Add(map[i]);
-      idr_index.push_back(i);
+      none.push_back({i});
     } else {
       finer.Add(map[i]);
     }
   }
-  if (idr.size() == 0 || finer.size() == 0) return covered_idr;
-  for (const rig::CameraView& view : views) {
+  std::vector<std::vector<IdrCover>> out(views.size(), none);
+  if (idr.size() == 0 || finer.size() == 0) return out;
+  for (size_t v = 0; v < views.size(); ++v) {
+    const rig::CameraView& view = views[v];
     cv::Mat idr_depth, idr_ids, finer_depth, finer_ids;
     idr.Render(view.world_T_camera, view.intrinsics, &idr_depth, &idr_ids);
     // The finer patches are read only where an IDR patch is seen.
     const cv::Rect seen = cv::boundingRect(idr_ids >= 0);
     if (seen.empty()) continue;
     finer.Render(view.world_T_camera, view.intrinsics, &finer_depth, &finer_ids, seen);
-    std::vector<long> footprint(idr.size(), 0), covered(idr.size(), 0);
+    std::vector<IdrCover>& cover = out[v];
     for (int y = 0; y < idr_ids.rows; ++y)
       for (int x = 0; x < idr_ids.cols; ++x)
         if (const int id = idr_ids.at<int>(y, x); id >= 0) {
-          ++footprint[id];
+          ++cover[id].shown;
           const int f = finer_ids.at<int>(y, x);
           if (f < 0) continue;
-          // Finer data behind the IDR patch is another surface it hides (the
-          // background seen past a near box's edge from another viewpoint),
-          // not a measurement of its own.
           const double zi = idr_depth.at<float>(y, x), zf = finer_depth.at<float>(y, x);
-          covered[id] += zf <= zi || PatchMap::SameSurface(zi, idr[id], zf, finer[f]);
+          if (PatchMap::SameSurface(zi, idr[id], zf, finer[f]))
+            ++cover[id].same_surface;
+          else if (zf <= zi)
+            ++cover[id].in_front;
         }
-    for (size_t k = 0; k < idr.size(); ++k)
-      covered_idr[idr_index[k]] |= footprint[k] > 0 && covered[k] >= share * footprint[k];
   }
+  return out;
+}
+
+std::vector<char> CoveredIdrPatches(const PatchMap& map, const std::vector<rig::CameraView>& views,
+                                    double share) {
+  std::vector<char> covered_idr(map.size(), 0);
+  for (const std::vector<IdrCover>& view : IdrCoverage(map, views))
+    for (const IdrCover& c : view)
+      // Finer data behind the IDR patch is another surface it hides (the
+      // background seen past a near box's edge from another viewpoint), not
+      // a measurement of its own.
+      covered_idr[c.index] |= c.shown > 0 && c.same_surface + c.in_front >= share * c.shown;
   return covered_idr;
 }
 

@@ -71,13 +71,29 @@ struct IntegrationStats {
 IntegrationStats Integrate(PatchMap* map, const PatchMap& fresh, const rig::CameraView& view,
                            const IntegrationOptions& options = {});
 
+/// How the map's foveal and peripheral patches cover one IDR patch in a
+/// view (IdrCoverage), in pixels of the IDR patches rendered alone.
+struct IdrCover {
+  size_t index = 0;       ///< the IDR patch's index in the map
+  long shown = 0;         ///< its pixels (not hidden by another IDR patch)
+  long same_surface = 0;  ///< of them, a finer patch of its surface (PatchMap::SameSurface)
+  long in_front = 0;      ///< of them, a finer patch of another surface in front of it
+};
+
+/// Per view, one IdrCover per IDR patch of the map (in map order); all
+/// counts 0 without finer patches. One split of the map, two renders per
+/// view (the finer patches only over the IDR patches' bounding box):
+/// O(N + views x pixels).
+std::vector<std::vector<IdrCover>> IdrCoverage(const PatchMap& map,
+                                               const std::vector<rig::CameraView>& views);
+
 /// Which of the map's patches (in map order) are IDR patches whose
 /// footprint in any of `views` (the IDR patches rendered alone) the map's
 /// foveal and peripheral patches (rendered alone) cover by `share` or more,
 /// at the IDR patch's surface or in front of it: the coarse guess adds
 /// nothing there. Finer data behind an IDR patch does not cover it: that is
 /// a farther surface seen past the IDR patch's edge from another viewpoint.
-/// One split of the map, two renders per view: O(N + views x pixels).
+/// From IdrCoverage.
 std::vector<char> CoveredIdrPatches(const PatchMap& map, const std::vector<rig::CameraView>& views,
                                     double share);
 
