@@ -10,14 +10,6 @@ std::optional<Eigen::Vector2d> ProjectWorldPoint(const Eigen::Isometry3d& world_
   return ProjectIntoCamera(world_T_camera.inverse(), intrinsics, p_W);
 }
 
-std::optional<Eigen::Vector2d> ProjectIntoCamera(const Eigen::Isometry3d& camera_T_world,
-                                                 const rig::CameraIntrinsics& intrinsics,
-                                                 const Eigen::Vector3d& p_W) {
-  const Eigen::Vector3d p_C = camera_T_world * p_W;
-  if (!(p_C.z() > 1e-9)) return std::nullopt;
-  return intrinsics.Project(p_C);
-}
-
 Ray PixelRay(const Eigen::Isometry3d& world_T_camera, const rig::CameraIntrinsics& intrinsics,
              const Eigen::Vector2d& uv) {
   return {world_T_camera.translation(),

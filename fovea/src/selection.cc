@@ -53,19 +53,23 @@ SelectionContext SelectionContext::Make(const cv::Mat& image, const rig::CameraV
   cv::Mat& ids = c.map_id;
   map.Render(view.world_T_camera, view.intrinsics, &c.map_depth_m, &ids);
   c.map_level = cv::Mat(ids.size(), CV_8S, cv::Scalar(-1));
-  for (int y = 0; y < ids.rows; ++y)
-    for (int x = 0; x < ids.cols; ++x) {
-      const int id = ids.at<int>(y, x);
-      if (id >= 0) c.map_level.at<signed char>(y, x) = static_cast<signed char>(map[id].level);
-    }
+  for (int y = 0; y < ids.rows; ++y) {
+    const int* id = ids.ptr<int>(y);
+    signed char* level = c.map_level.ptr<signed char>(y);
+    for (int x = 0; x < ids.cols; ++x)
+      if (id[x] >= 0) level[x] = static_cast<signed char>(map[id[x]].level);
+  }
   if (fill_holes) FillHoles(&c);
   cv::Mat points(c.map_depth_m.size(), CV_64FC3, cv::Scalar::all(0));
-  for (int y = 0; y < c.map_depth_m.rows; ++y)
-    for (int x = 0; x < c.map_depth_m.cols; ++x)
-      if (c.map_depth_m.at<float>(y, x) > 0) {
+  for (int y = 0; y < points.rows; ++y) {
+    const float* depth = c.map_depth_m.ptr<float>(y);
+    cv::Vec3d* point = points.ptr<cv::Vec3d>(y);
+    for (int x = 0; x < points.cols; ++x)
+      if (depth[x] > 0) {
         const Eigen::Vector3d p = PointAt(c, x, y);
-        points.at<cv::Vec3d>(y, x) = cv::Vec3d(p.x(), p.y(), p.z());
+        point[x] = cv::Vec3d(p.x(), p.y(), p.z());
       }
+  }
   c.map_points_W = points;
   return c;
 }
@@ -76,22 +80,31 @@ void NormalizeSum(cv::Mat* w) {
 }
 
 cv::Mat GradientAttraction::Evaluate(const SelectionContext& c) const {
+  // In single precision: a smooth attraction map needs no more than its 24
+  // bits, and the blurs run on twice the lanes (issue 21).
   cv::Mat f, gx, gy;
-  c.image.convertTo(f, CV_64F);
+  c.image.convertTo(f, CV_32F);
   cv::GaussianBlur(f, f, cv::Size(), sigma_);
-  cv::Sobel(f, gx, CV_64F, 1, 0, 3, 1.0 / 8);
-  cv::Sobel(f, gy, CV_64F, 0, 1, 3, 1.0 / 8);
-  cv::Mat g = gx.mul(gx) + gy.mul(gy);
+  cv::Sobel(f, gx, CV_32F, 1, 0, 3, 1.0 / 8);
+  cv::Sobel(f, gy, CV_32F, 0, 1, 3, 1.0 / 8);
+  cv::Mat g(f.size(), CV_32F);
+  for (int y = 0; y < g.rows; ++y) {
+    const float *dx = gx.ptr<float>(y), *dy = gy.ptr<float>(y);
+    float* e = g.ptr<float>(y);
+    for (int x = 0; x < g.cols; ++x) e[x] = dx[x] * dx[x] + dy[x] * dy[x];
+  }
   // Texture is a regional property: average the energy over a window.
   cv::GaussianBlur(g, g, cv::Size(), 2 * sigma_);
   // Saturate at the 80th percentile: every well-textured region attracts
   // alike, so that the strong contrast of an occluding edge does not hold
   // the eye on the edge fixation after fixation.
-  std::vector<double> v(g.begin<double>(), g.end<double>());
+  std::vector<double> v(g.begin<float>(), g.end<float>());
   const double cap = NthSmallest(&v, v.size() * 8 / 10);
   if (cap > 0) cv::min(g, cap, g);
-  NormalizeSum(&g);
-  return g;
+  cv::Mat w;
+  g.convertTo(w, CV_64F);
+  NormalizeSum(&w);
+  return w;
 }
 
 Eigen::Vector3d SelectionContext::MapPoint(int x, int y) const {
@@ -164,13 +177,14 @@ cv::Mat LocalSuppression::Evaluate(const SelectionContext& c) const {
     if ((v.aimed_W - v.settled_W).norm() > revisit_) points.push_back(v.aimed_W);
   }
   cv::Mat w(c.map_level.size(), CV_64F, cv::Scalar(1.0));
-  for (int y = 0; y < w.rows; ++y)
+  for (int y = 0; y < w.rows; ++y) {
+    const signed char* level = c.map_level.ptr<signed char>(y);
+    double* wp = w.ptr<double>(y);
     for (int x = 0; x < w.cols; ++x) {
-      const signed char level = c.map_level.at<signed char>(y, x);
-      double& wp = w.at<double>(y, x);
-      if (level == static_cast<signed char>(PatchLevel::kFoveal)) wp = low_;
-      if (level == static_cast<signed char>(PatchLevel::kPeripheral)) wp = peripheral_;
+      if (level[x] == static_cast<signed char>(PatchLevel::kFoveal)) wp[x] = low_;
+      if (level[x] == static_cast<signed char>(PatchLevel::kPeripheral)) wp[x] = peripheral_;
     }
+  }
   // Each point suppresses only the pixels whose map points lie within the
   // radius: visiting just the pixels it can reach keeps the cost per
   // fixation from growing with the fixations made (0 within the revisit
@@ -270,9 +284,11 @@ cv::Mat Candidates(const SelectionContext& c, const std::vector<Eigen::Vector3d>
   // The region camera's inverse pose once, not per pixel.
   const Eigen::Isometry3d region_T_world =
       c.region ? c.region->world_T_camera.inverse() : Eigen::Isometry3d::Identity();
-  for (int y = b; y < candidates.rows - b; ++y)
+  for (int y = b; y < candidates.rows - b; ++y) {
+    const float* depth = c.map_depth_m.ptr<float>(y);
+    uchar* candidate = candidates.ptr<uchar>(y);
     for (int x = b; x < candidates.cols - b; ++x) {
-      if (!(c.map_depth_m.at<float>(y, x) > 0)) continue;
+      if (!(depth[x] > 0)) continue;
       if (c.region) {
         const auto& k = c.region->intrinsics;
         const auto uv = ProjectIntoCamera(region_T_world, k, c.MapPoint(x, y));
@@ -280,8 +296,9 @@ cv::Mat Candidates(const SelectionContext& c, const std::vector<Eigen::Vector3d>
             uv->y() > k.height_px - 1 - b)
           continue;
       }
-      candidates.at<uchar>(y, x) = 255;
+      candidate[x] = 255;
     }
+  }
   ClearNear(c, refused_W, options.refused_radius_m, &candidates);
   return candidates;
 }

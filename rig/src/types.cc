@@ -80,12 +80,12 @@ Eigen::Vector2d Distort(const std::vector<double>& k, const Eigen::Vector2d& xy)
 }
 }  // namespace
 
-Eigen::Vector2d CameraIntrinsics::Project(const Eigen::Vector3d& p_C) const {
+Eigen::Vector2d CameraIntrinsics::ProjectDistorted(const Eigen::Vector3d& p_C) const {
   const Eigen::Vector2d d = Distort(distortion, {p_C.x() / p_C.z(), p_C.y() / p_C.z()});
   return {fx_px * d.x() + cx_px, fy_px * d.y() + cy_px};
 }
 
-Eigen::Vector3d CameraIntrinsics::Ray(const Eigen::Vector2d& uv) const {
+Eigen::Vector3d CameraIntrinsics::RayDistorted(const Eigen::Vector2d& uv) const {
   const Eigen::Vector2d target((uv.x() - cx_px) / fx_px, (uv.y() - cy_px) / fy_px);
   Eigen::Vector2d xy = target;
   if (!distortion.empty()) {

@@ -21,9 +21,13 @@ std::optional<Eigen::Vector2d> ProjectWorldPoint(const Eigen::Isometry3d& world_
 
 /// The same from the inverse pose (camera_T_world = world_T_camera^-1), for
 /// callers that project many points into one camera.
-std::optional<Eigen::Vector2d> ProjectIntoCamera(const Eigen::Isometry3d& camera_T_world,
-                                                 const rig::CameraIntrinsics& intrinsics,
-                                                 const Eigen::Vector3d& p_W);
+inline std::optional<Eigen::Vector2d> ProjectIntoCamera(const Eigen::Isometry3d& camera_T_world,
+                                                        const rig::CameraIntrinsics& intrinsics,
+                                                        const Eigen::Vector3d& p_W) {
+  const Eigen::Vector3d p_C = camera_T_world * p_W;
+  if (!(p_C.z() > 1e-9)) return std::nullopt;
+  return intrinsics.Project(p_C);
+}
 
 /// A ray in the world: origin and unit direction.
 struct Ray {

@@ -51,12 +51,23 @@ struct CameraIntrinsics {
   double VerticalFovRad() const;
 
   /// Pixel where the camera-frame point p_C (z > 0) projects, distortion
-  /// applied. Undefined for z <= 0.
-  Eigen::Vector2d Project(const Eigen::Vector3d& p_C) const;
+  /// applied. Undefined for z <= 0. (Inline without distortion: the
+  /// per-pixel loops call it.)
+  Eigen::Vector2d Project(const Eigen::Vector3d& p_C) const {
+    if (!distortion.empty()) return ProjectDistorted(p_C);
+    return {fx_px * (p_C.x() / p_C.z()) + cx_px, fy_px * (p_C.y() / p_C.z()) + cy_px};
+  }
 
   /// Direction in the camera frame, scaled so that z = 1, of the ray through
   /// pixel uv (distortion removed by fixed-point iteration).
-  Eigen::Vector3d Ray(const Eigen::Vector2d& uv) const;
+  Eigen::Vector3d Ray(const Eigen::Vector2d& uv) const {
+    if (!distortion.empty()) return RayDistorted(uv);
+    return {(uv.x() - cx_px) / fx_px, (uv.y() - cy_px) / fy_px, 1.0};
+  }
+
+  /// Project and Ray with the distortion (Project and Ray call them).
+  Eigen::Vector2d ProjectDistorted(const Eigen::Vector3d& p_C) const;
+  Eigen::Vector3d RayDistorted(const Eigen::Vector2d& uv) const;
 
   bool InImage(const Eigen::Vector2d& uv) const;
   cv::Matx33d K() const;
