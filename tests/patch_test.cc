@@ -6,6 +6,7 @@
 #include <random>
 
 #include "fovea/foveal.h"
+#include "test_views.h"
 
 namespace {
 std::vector<fovea::DisparitySample> PlaneSamples(double a, double b, double c, double x0, double y0,
@@ -331,4 +332,49 @@ TEST_CASE("a block's matches beside an unmatched stretch count in its fit, not i
   CHECK(fovea::FitBlocks(sliver, 16, options, whole, nullptr,
                          fovea::BesideUnmatchedRuns(sliver, 3, 4))
             .empty());
+}
+
+TEST_CASE("foveal pixels near a depth jump or a hole of the map are marked, no others",
+          "[fovea][foveal]") {
+  // Rectangles x0..x1 by z -1..1 at depth y, seen by a camera at the origin
+  // looking along +y: columns 0-79 show x < 0, columns 80-159 x > 0.
+  auto rect = [](double x0, double x1, double y, fovea::PatchLevel level) {
+    fovea::Patch p;
+    p.corners_W = {Eigen::Vector3d(x0, y, -1), Eigen::Vector3d(x1, y, -1),
+                   Eigen::Vector3d(x1, y, 1), Eigen::Vector3d(x0, y, 1)};
+    p.level = level;
+    return p;
+  };
+  const rig::CameraView view = ForwardView(160, 120, 150);
+  auto marked = [&](const fovea::PatchMap& map, int radius) {
+    cv::Mat depth, ids;
+    map.Render(view.world_T_camera, view.intrinsics, &depth, &ids);
+    return fovea::FovealNearEdges(map, depth, ids, radius);
+  };
+  using L = fovea::PatchLevel;
+  auto row = [](const cv::Mat& m, int lo, int hi, int lo2 = -1, int hi2 = -1) {
+    for (int x = 0; x < m.cols; ++x) {
+      INFO("column " << x);
+      const bool in = (x >= lo && x <= hi) || (x >= lo2 && x <= hi2);
+      CHECK(m.at<uchar>(60, x) == (in ? 1 : 0));
+    }
+  };
+  fovea::PatchMap jump;
+  jump.Add(rect(-1, 0, 1.0, L::kFoveal));
+  jump.Add(rect(0, 1, 1.2, L::kFoveal));
+  // The jump lies between columns 79 and 80; the image's border is no edge.
+  row(marked(jump, 4), 75, 84);
+  CHECK(marked(jump, 0).empty());
+  fovea::PatchMap same;  // 1 mm apart: one surface
+  same.Add(rect(-1, 0, 1.0, L::kFoveal));
+  same.Add(rect(0, 1, 1.001, L::kFoveal));
+  row(marked(same, 4), -1, -1);
+  fovea::PatchMap peripheral;  // only foveal pixels are marked
+  peripheral.Add(rect(-1, 0, 1.0, L::kFoveal));
+  peripheral.Add(rect(0, 1, 1.2, L::kPeripheral));
+  row(marked(peripheral, 4), 75, 79);
+  fovea::PatchMap hole;  // columns 65-79 unmapped, one depth on both sides
+  hole.Add(rect(-1, -0.1, 1.0, L::kFoveal));
+  hole.Add(rect(0, 1, 1.0, L::kFoveal));
+  row(marked(hole, 2), 62, 64, 80, 82);
 }

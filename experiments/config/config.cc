@@ -286,6 +286,7 @@ void AddFovealParams(RunConfig* c, std::vector<ConfigParam>* params) {
                      {&fp::kFovealPeripheryMinBlockPx, &x.foveal.periphery_min_block_px},
                      {&fp::kFovealClipToInliers, &x.foveal.blocks.clip_to_inliers},
                      {&fp::kFovealRectify, &x.foveal.rectify},
+                     {&fp::kFovealSkipFovealEdgePx, &x.foveal.skip_foveal_edge_px},
                      {&fp::kFovealFitMinSupport, &x.foveal.plane_fit.min_support},
                      {&fp::kFovealFitTolerancePx, &x.foveal.plane_fit.fit_tolerance_px},
                      {&fp::kFovealFitMinInlierShare, &x.foveal.plane_fit.min_inlier_share},

@@ -16,6 +16,7 @@ namespace fovea {
 void FovealOptions::Check() const {
   tessellation.Check();
   rig::CheckParam(params::kFovealFoveaPatchPx, fovea_patch_px);
+  rig::CheckParam(params::kFovealSkipFovealEdgePx, skip_foveal_edge_px);
   rig::CheckParam(params::kFovealPeripheryPatchPx, periphery_patch_px);
   rig::CheckParam(params::kFovealMapMarginPx, map_margin_px);
   rig::CheckParam(params::kFovealCoarseMarginPx, coarse_margin_px);
@@ -154,6 +155,37 @@ class PixelDisparity {
   double u_ = 0;
 };
 
+}  // namespace
+
+cv::Mat FovealNearEdges(const PatchMap& map, const cv::Mat& depth, const cv::Mat& ids, int radius) {
+  if (radius <= 0) return {};
+  cv::Mat edge = cv::Mat::zeros(depth.size(), CV_8U);
+  for (int y = 0; y < depth.rows; ++y)
+    for (int x = 0; x < depth.cols; ++x) {
+      const float z = depth.at<float>(y, x);
+      auto apart = [&](int u, int v) {
+        const float n = depth.at<float>(v, u);
+        return !(z > 0) || !(n > 0) ||
+               std::abs(z - n) > PatchMap::kSameSurfaceShare * std::min(z, n);
+      };
+      if ((x + 1 < depth.cols && apart(x + 1, y)) || (y + 1 < depth.rows && apart(x, y + 1))) {
+        edge.at<uchar>(y, x) = 1;
+        if (x + 1 < depth.cols) edge.at<uchar>(y, x + 1) = 1;
+        if (y + 1 < depth.rows) edge.at<uchar>(y + 1, x) = 1;
+      }
+    }
+  cv::dilate(edge, edge,
+             cv::getStructuringElement(cv::MORPH_RECT, {2 * radius + 1, 2 * radius + 1}));
+  for (int y = 0; y < ids.rows; ++y)
+    for (int x = 0; x < ids.cols; ++x) {
+      const int id = ids.at<int>(y, x);
+      if (id < 0 || map[id].level != PatchLevel::kFoveal) edge.at<uchar>(y, x) = 0;
+    }
+  return edge;
+}
+
+namespace {
+
 // Per-pixel disparity ranges of one level (lo > hi: not searched): around the
 // coarser level's estimate, else around the map's prediction, else (the map
 // silent) the Z_T band about the fixation depth, marked in `silent`.
@@ -163,8 +195,8 @@ struct SearchRanges {
 };
 
 SearchRanges LevelRanges(const rig::StereoFrame& frame, const Tessellation& t,
-                         const cv::Mat& map_depth, const cv::Mat* coarse, const Level& level,
-                         const FovealOptions& options) {
+                         const cv::Mat& map_depth, const cv::Mat& skip, const cv::Mat* coarse,
+                         const Level& level, const FovealOptions& options) {
   const rig::CameraIntrinsics& k = frame.left.intrinsics;
   const double s = level.scale, z0 = t.fixation_depth_m;
   PixelDisparity disparity(frame, s);
@@ -174,10 +206,13 @@ SearchRanges LevelRanges(const rig::StereoFrame& frame, const Tessellation& t,
                  cv::Mat(size, CV_8U, cv::Scalar(0))};
   // The level's pixels whose centres may fall in its rectangle.
   const cv::Rect inside = LevelPixels(level.rect, s) & cv::Rect(cv::Point(), size);
+  // The finer level's rectangle (its coarse estimates are needed there).
+  const cv::Rect inner = level.index > 0 ? t.rects[level.index - 1] : cv::Rect();
   for (int y = inside.y; y < inside.br().y; ++y)
     for (int x = inside.x; x < inside.br().x; ++x) {
       const auto [u, v, ui, vi] = grid.At(x, y);
       if (!level.rect.contains({ui, vi}) || t.mask.at<uchar>(vi, ui) == 0) continue;
+      if (!skip.empty() && skip.at<uchar>(vi, ui) && !inner.contains({ui, vi})) continue;
       double dlo, dhi;
       const float cd = coarse ? coarse->at<float>(std::min(coarse->rows - 1, y / 2),
                                                   std::min(coarse->cols - 1, x / 2))
@@ -435,8 +470,9 @@ FovealResult FovealStereo(const FixationFrame& matched, const Eigen::Vector3d& f
   FovealResult result;
   result.frame = matched;
   const rig::StereoFrame& frame = result.frame.views;
-  cv::Mat map_depth;
-  map.Render(frame.left.world_T_camera, frame.left.intrinsics, &map_depth, nullptr);
+  cv::Mat map_depth, map_ids;
+  map.Render(frame.left.world_T_camera, frame.left.intrinsics, &map_depth, &map_ids);
+  const cv::Mat skip = FovealNearEdges(map, map_depth, map_ids, options.skip_foveal_edge_px);
   result.tessellation =
       TessellateFromDepth(frame.left, frame.right, fixation_W, map_depth, options.tessellation);
   Tessellation& t = result.tessellation;
@@ -456,7 +492,8 @@ FovealResult FovealStereo(const FixationFrame& matched, const Eigen::Vector3d& f
     const auto t0 = Clock::now();
     const Level level = MakeLevel(frame, t, index);
     const cv::Mat* coarse = index + 1 < levels ? &result.disparity_px[index + 1] : nullptr;
-    SearchRanges ranges = LevelRanges(frame, t, map_depth, coarse, level, options);
+    SearchRanges ranges =
+        LevelRanges(frame, t, map_depth, index > 0 ? skip : cv::Mat(), coarse, level, options);
     DisparityMap dm = matcher.Match(level.left, level.right, ranges.lo, ranges.hi);
     const int outside_band =
         silent.wide.empty() ? 0 : DropOutsideBand(silent, level, ranges, options, &dm);

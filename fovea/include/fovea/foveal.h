@@ -77,6 +77,14 @@ struct FovealOptions {
   /// images. Fixate hands it to the servo (ServoOptions::rectify), which
   /// measures in that frame and passes it on (ServoResult::measured).
   bool rectify = true;
+  /// Beyond the paper (issue 19, off by default: README, "The map's
+  /// trust"): with this > 0 the peripheral levels do not match the pixels,
+  /// outside the finer level's rectangle, where the map shows a foveal patch
+  /// within this many full-resolution pixels of a depth jump or of a pixel
+  /// it does not map (FovealNearEdges): there such matches carry the foveal
+  /// side's depth into peripheral blocks that straddle the edge. 0: every
+  /// pixel of every level.
+  int skip_foveal_edge_px = 0;
   void Check() const;  ///< throws rig::InputError naming the key (fovea/params.h)
 };
 
@@ -128,6 +136,13 @@ int ErodeAtDisparityJumps(int radius, double jump_px, cv::Mat* disparity);
 /// a run of at least `run_px` NaN pixels of `disparity` (CV_32F) on that
 /// line; all 0 if either is 0 (FovealOptions::edge_hole_px).
 cv::Mat BesideUnmatchedRuns(const cv::Mat& disparity, int radius, int run_px);
+
+/// The pixels (CV_8U, 1) where the map, rendered as `depth` and `ids`
+/// (PatchMap::Render), shows a foveal patch within `radius` pixels of a
+/// depth jump (more than PatchMap::kSameSurfaceShare of the depth between
+/// 4-neighbours) or of a pixel the map leaves empty
+/// (FovealOptions::skip_foveal_edge_px); empty when radius is 0.
+cv::Mat FovealNearEdges(const PatchMap& map, const cv::Mat& depth, const cv::Mat& ids, int radius);
 
 /// Matches a verged pair that fixates p_W, level by level, coarse to fine,
 /// with the range at each pixel bounded by `map` (or by Z_T where the map is

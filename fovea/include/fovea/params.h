@@ -207,6 +207,12 @@ inline constexpr ParamSpec kFovealRectify{
     "beyond the paper: servo, tessellate and match in the pair's fixation frame (both images "
     "turned so that a tilted verged pair's rows do not twist and the optical axes meet; false = "
     "the paper's unrectified images)"};
+inline constexpr ParamSpec kFovealSkipFovealEdgePx{
+    "foveal.skip_foveal_edge_px",
+    "beyond the paper: the peripheral levels do not match pixels outside the finer level's "
+    "rectangle where the map shows a foveal patch within this many pixels of a depth jump or a "
+    "hole in the map (0 = match every pixel of every level)",
+    0, 64};
 inline constexpr ParamSpec kFovealFitMinSupport{
     "foveal.fit_min_support",
     "foveal and peripheral patch fit: inlier measurements needed in a block", 3, 4096};
