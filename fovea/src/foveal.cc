@@ -16,7 +16,6 @@ namespace fovea {
 void FovealOptions::Check() const {
   tessellation.Check();
   rig::CheckParam(params::kFovealFoveaPatchPx, fovea_patch_px);
-  rig::CheckParam(params::kFovealSkipFovealEdgePx, skip_foveal_edge_px);
   rig::CheckParam(params::kFovealPeripheryPatchPx, periphery_patch_px);
   rig::CheckParam(params::kFovealMapMarginPx, map_margin_px);
   rig::CheckParam(params::kFovealCoarseMarginPx, coarse_margin_px);
@@ -32,6 +31,7 @@ void FovealOptions::Check() const {
                   params::kFovealFitMinInlierShare);
   // Set from idr.z_min_m (ResolvedFixationOptions), not a parameter of its own.
   if (!(silent_near_m >= 0)) throw rig::InputError("foveal options: silent_near_m must be >= 0");
+  rig::CheckParam(params::kFovealSkipFovealEdgePx, skip_foveal_edge_px);
 }
 
 void FixationOptions::Check() const {
@@ -97,19 +97,19 @@ struct FullResolutionPixel {
 // the cost in the per-pixel loops below.
 class LevelGrid {
  public:
-  LevelGrid(cv::Size size, double scale, const rig::CameraIntrinsics& k) : k_(k) {
-    separable_ = k.distortion.empty();
+  LevelGrid(cv::Size size, double scale, const rig::CameraIntrinsics& k)
+      : k_(k), separable_(k.distortion.empty()) {
     for (int x = 0; x < size.width; ++x) {
       const double u = (x + 0.5) * scale - 0.5;
       u_.push_back(u);
       ui_.push_back(std::clamp(static_cast<int>(std::lround(u)), 0, k.width_px - 1));
-      ray_x_.push_back(k.Ray({u, 0.0}).x());
+      if (separable_) ray_x_.push_back(k.Ray({u, 0.0}).x());
     }
     for (int y = 0; y < size.height; ++y) {
       const double v = (y + 0.5) * scale - 0.5;
       v_.push_back(v);
       vi_.push_back(std::clamp(static_cast<int>(std::lround(v)), 0, k.height_px - 1));
-      ray_y_.push_back(k.Ray({0.0, v}).y());
+      if (separable_) ray_y_.push_back(k.Ray({0.0, v}).y());
     }
   }
   FullResolutionPixel At(int x, int y) const { return {u_[x], v_[y], ui_[x], vi_[y]}; }
@@ -119,7 +119,7 @@ class LevelGrid {
 
  private:
   const rig::CameraIntrinsics& k_;
-  bool separable_ = true;
+  const bool separable_;  ///< no distortion: a pixel's ray is (ray_x_[x], ray_y_[y], 1)
   std::vector<double> u_, v_, ray_x_, ray_y_;
   std::vector<int> ui_, vi_;
 };
