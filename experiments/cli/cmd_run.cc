@@ -223,6 +223,7 @@ int Run(const RunArgs& args) {
   options.seed = config.seed;
   const fovea::FoveaRun run = fovea::RunFovea(
       rig, *fovea::MakeMatcher(config.matcher, config.fovea), options, std::ref(recorder));
+  recorder.Finish();
   t = Clock::now();
   const MapScore score =
       ScoreMap(run.map, ref, sim->truth(), config.fovea.fixation.baseline_m, /*per_patch=*/true);

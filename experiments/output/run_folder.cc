@@ -181,12 +181,38 @@ nlohmann::json Recorder::SurfaceAt(const Eigen::Vector3d& p_W) const {
   return {{"name", truth_.GeomName(nearest->geom_id)}, {"distance_m", nearest->distance_m}};
 }
 
+Recorder::~Recorder() {
+  if (pending_ && pending_->score.valid()) pending_->score.wait();
+}
+
 void Recorder::operator()(const fovea::FixationRecord& r, const fovea::PatchMap& map) {
+  Finish();
   auto t = fovea::Clock::now();
-  const MapScore score = ScoreMap(map, ref_, truth_, baseline_m_, false);
+  Pending p;
+  p.record = r;
+  if (r.ok) p.surface = SurfaceAt(r.fixation_W);
+  p.map = std::make_shared<const fovea::PatchMap>(map);
+  p.score = std::async(std::launch::async, [this, m = p.map] {
+    return ScoreMap(*m, ref_, truth_, baseline_m_, false);
+  });
+  pending_ = std::move(p);
   scoring_s += fovea::Since(t);
+}
+
+void Recorder::Finish() {
+  if (!pending_) return;
+  Pending p = std::move(*pending_);
+  pending_.reset();
+  Complete(&p);
+}
+
+void Recorder::Complete(Pending* pending) {
+  auto t = fovea::Clock::now();
+  const MapScore score = pending->score.get();
+  scoring_s += fovea::Since(t);
+  const fovea::FixationRecord& r = pending->record;
   nlohmann::json record = RecordJson(r, score);
-  if (r.ok) record["surface"] = SurfaceAt(r.fixation_W);
+  if (r.ok) record["surface"] = pending->surface;
   jsonl_ += record.dump() + "\n";
   if (r.ok)
     path_.push_back(r.fixation_W);
@@ -207,7 +233,7 @@ void Recorder::operator()(const fovea::FixationRecord& r, const fovea::PatchMap&
     std::snprintf(caption, sizeof caption, "%s after fixation %d: %s", scene_name_.c_str(),
                   r.fixation, ScoreLine(score, /*brief=*/true).c_str());
     WriteImageAtomic(dir_ + "/" + SnapshotName(r.fixation),
-                     MapSnapshot(map, ref_, view_target_, caption));
+                     MapSnapshot(*pending->map, ref_, view_target_, caption));
   }
   output_s += fovea::Since(t);
 }

@@ -4,7 +4,10 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <future>
+#include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -60,21 +63,48 @@ nlohmann::json SummaryJson(const MapScore& score, const std::string& scene_path,
 /// The fixation observer of a run: scores the map after every attempt,
 /// keeps the records, the fixation path, and the map's pictures after the
 /// snapshot fixations, and prints a progress line.
+///
+/// An attempt's map is scored on a second thread, from a copy of the map,
+/// while the run goes on to the next attempt (servoing, which renders and
+/// steps the simulation, is most of a fixation's wall time); the record is
+/// completed, in order, when the next attempt arrives or at Finish. Only the
+/// scoring runs there: it reads the reference view and the model's names,
+/// never the simulation's state, so the records are the same as scored in
+/// line. The true surface a fixation landed on (ray casts into the
+/// simulation) is found at once.
 class Recorder {
  public:
   Recorder(const std::string& dir, const std::string& scene_path, const ReferenceView& ref,
            const sim::GroundTruth& truth, const RunConfig& config);
+  /// Waits for an attempt still being scored (its result is dropped).
+  ~Recorder();
+  Recorder(const Recorder&) = delete;
+  Recorder& operator=(const Recorder&) = delete;
   void operator()(const fovea::FixationRecord& record, const fovea::PatchMap& map);
+  /// Completes the last attempt's record; call it before reading the
+  /// records, the path or the refused points.
+  void Finish();
   const std::string& records() const { return jsonl_; }
   const std::vector<Eigen::Vector3d>& path() const { return path_; }
   const std::vector<Eigen::Vector3d>& refused() const { return refused_; }
-  double scoring_s = 0, output_s = 0;  ///< wall clock spent scoring and writing
+  /// Wall clock the run waited for scoring (scoring that overlapped the
+  /// next attempt is not counted) and spent writing.
+  double scoring_s = 0, output_s = 0;
   /// The true surface nearest a point ({"name", "distance_m"}, nulls when
   /// nothing is near): which surface a fixation landed on, and how far off
   /// it (a false fixation floats).
   nlohmann::json SurfaceAt(const Eigen::Vector3d& p_W) const;
 
  private:
+  /// An attempt whose map is being scored.
+  struct Pending {
+    fovea::FixationRecord record;
+    nlohmann::json surface;
+    std::shared_ptr<const fovea::PatchMap> map;
+    std::future<MapScore> score;
+  };
+  void Complete(Pending* pending);
+
   std::string dir_, scene_name_;
   const ReferenceView& ref_;
   const sim::GroundTruth& truth_;
@@ -84,6 +114,7 @@ class Recorder {
   Eigen::Vector3d view_target_ = Eigen::Vector3d::Zero();
   std::string jsonl_;
   std::vector<Eigen::Vector3d> path_, refused_;
+  std::optional<Pending> pending_;
 };
 
 }  // namespace experiments::run_folder
