@@ -76,17 +76,30 @@ TEST_CASE("map score: the pixels near edges are split by the source of the patch
   const long edge_pixels = j["edge_pixels"];
   REQUIRE(edge_pixels > 0);
   long pixels = 0;
-  double bad = 0;
+  double bad = 0, bad_nearer = 0;
   for (const char* source : {"idr", "0", "1"}) {
     INFO("source " << source);
     REQUIRE(j["edge_by_source"].contains(source));
-    const long n = j["edge_by_source"][source]["pixels"];
+    const nlohmann::json& e = j["edge_by_source"][source];
+    const long n = e["pixels"];
     CHECK(n > 0);  // the blocks' edges lie in all three thirds
     pixels += n;
-    bad += n * j["edge_by_source"][source]["bad_share"].get<double>();
+    bad += n * e["bad_share"].get<double>();
+    if (!e["bad_nearer_share"].is_null())
+      bad_nearer += n * e["bad_share"].get<double>() * e["bad_nearer_share"].get<double>();
   }
   CHECK(pixels == edge_pixels);
   CHECK(bad == Approx(edge_pixels * j["edge_bad_share"].get<double>()).epsilon(1e-9));
+  // The IDR quad lies at the back plane's depth: where it is wrong (over
+  // the slanted plane and the blocks, all nearer), it is too far.
+  REQUIRE(j["edge_by_source"]["idr"]["bad_share"].get<double>() > 0);
+  CHECK(j["edge_by_source"]["idr"]["bad_nearer_share"].get<double>() == 0);
+  CHECK(j["by_level"]["idr"]["bad_nearer_share"].get<double>() == 0);
+  // The split adds up over the sources.
+  CHECK(bad_nearer == Approx(edge_pixels * j["edge_bad_share"].get<double>() *
+                             j["edge_bad_nearer_share"].get<double>())
+                          .epsilon(1e-9));
+  CHECK(j["edge_bad_nearer_share"].get<double>() > 0);  // the quads before the back plane
 }
 
 TEST_CASE("error picture: right pixels green, too near red, too far magenta, true edges blue",

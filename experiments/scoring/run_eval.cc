@@ -16,12 +16,15 @@ using fovea::Quantile;
 namespace {
 
 struct Accumulator {
-  long bad = 0;
+  long bad = 0, bad_nearer = 0;
   std::vector<double> abs, rel, steps;
   double sum_sq = 0, sum_abs = 0;
   long within = 0;
   void Add(double z, double zt, double step) {
-    if (!(std::abs(z - zt) <= kBadShare * zt)) ++bad;
+    if (!(std::abs(z - zt) <= kBadShare * zt)) {
+      ++bad;
+      bad_nearer += z < zt;
+    }
     const double e = std::abs(z - zt);
     abs.push_back(e);
     rel.push_back(e / zt);
@@ -35,6 +38,7 @@ struct Accumulator {
     ErrorFigures f;
     f.pixels = static_cast<long>(abs.size());
     f.bad = bad;
+    f.bad_nearer = bad_nearer;
     f.share = total ? double(f.pixels) / total : 0;
     if (abs.empty()) return f;
     f.median_abs_error_m = fovea::QuantileInPlace(&abs, 0.5);
@@ -437,9 +441,25 @@ nlohmann::json BadShare(const ErrorFigures& f) {
   return Figure(f.pixels, f.pixels ? double(f.bad) / f.pixels : 0);
 }
 
+// Share of a figure's bad pixels that the map puts nearer than the truth
+// (a nearer surface's depth carried over its edge, window matching's
+// fattening) rather than farther (a farther surface's patch seen where the
+// nearer surface is unmapped, or a plane tilted away): null without a bad
+// pixel.
+nlohmann::json BadNearerShare(const ErrorFigures& f) {
+  return Figure(f.bad, f.bad ? double(f.bad_nearer) / f.bad : 0);
+}
+
+// The pixels of a figure, their bad share and its nearer part.
+nlohmann::json BadJson(const ErrorFigures& f) {
+  return {
+      {"pixels", f.pixels}, {"bad_share", BadShare(f)}, {"bad_nearer_share", BadNearerShare(f)}};
+}
+
 nlohmann::json ErrorJson(const ErrorFigures& f) {
   return {{"pixels", f.pixels},
           {"bad_share", BadShare(f)},
+          {"bad_nearer_share", BadNearerShare(f)},
           {"share", f.share},
           {"median_abs_error_m", Figure(f.pixels, f.median_abs_error_m)},
           {"mean_abs_error_m", Figure(f.pixels, f.mean_abs_error_m)},
@@ -471,13 +491,11 @@ nlohmann::json ScoreJson(const MapScore& s) {
   j["edge_bad_share"] = BadShare(s.near_edges);
   j["edge_pixels"] = s.near_edges.pixels;
   // Where the pixels near edges come from: IDR, or a resolution level.
-  j["edge_by_source"]["idr"] = {{"pixels", s.near_edges_idr.pixels},
-                                {"bad_share", BadShare(s.near_edges_idr)}};
+  j["edge_bad_nearer_share"] = BadNearerShare(s.near_edges);
+  j["edge_by_source"]["idr"] = BadJson(s.near_edges_idr);
   for (int i = 0; i < 6; ++i)
     if (s.near_edges_by_resolution[i].pixels > 0)
-      j["edge_by_source"][std::to_string(i)] = {
-          {"pixels", s.near_edges_by_resolution[i].pixels},
-          {"bad_share", BadShare(s.near_edges_by_resolution[i])}};
+      j["edge_by_source"][std::to_string(i)] = BadJson(s.near_edges_by_resolution[i]);
   for (int i = 0; i < 3; ++i)
     j["by_level"][fovea::PatchLevelName(static_cast<fovea::PatchLevel>(i))] =
         ErrorJson(s.by_level[i]);

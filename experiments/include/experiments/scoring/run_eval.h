@@ -66,9 +66,10 @@ constexpr int kStereoPositions = 8;
 ReferenceView MakeReferenceView(rig::Rig& rig, sim::Simulation& sim);
 
 struct ErrorFigures {
-  long pixels = 0;   ///< mapped textured pixels scored
-  long bad = 0;      ///< of them, off by more than kBadShare of depth
-  double share = 0;  ///< of the visible textured pixels
+  long pixels = 0;      ///< mapped textured pixels scored
+  long bad = 0;         ///< of them, off by more than kBadShare of depth
+  long bad_nearer = 0;  ///< of the bad ones, those the map puts nearer than the truth
+  double share = 0;     ///< of the visible textured pixels
   double median_abs_error_m = 0, mean_abs_error_m = 0, rmse_m = 0;
   double median_rel_error = 0;    ///< |Z - Z_true| / Z_true
   double within_1pct = 0;         ///< share of scored pixels within 1% of depth
