@@ -231,6 +231,63 @@ TEST_CASE("a block's patch covers its inliers, not the far side of an edge witho
   CHECK(tiled[0].footprint.isApprox(Eigen::Vector4d(-0.5, -0.5, 15.5, 15.5)));
 }
 
+TEST_CASE("with clip_diagonals a block's patch stops at an edge that crosses it at a slant",
+          "[fovea][patch]") {
+  // One 16-pixel block: a plane where x >= y - 4, no match below that
+  // line (the far side of a depth edge crossing the block at 45 degrees).
+  // The inliers (190) fill 74% of the block and reach all four quadrants,
+  // so it stays whole; the 66 pixels beyond the edge are empty.
+  cv::Mat d(16, 16, CV_32F, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
+  for (int y = 0; y < 16; ++y)
+    for (int x = std::max(0, y - 4); x < 16; ++x) d.at<float>(y, x) = 12.f + 0.05f * x;
+  fovea::PlaneFitOptions options;
+  fovea::BlockOptions blocks;
+  blocks.clip_diagonals = true;
+  const auto hugged = fovea::FitBlocks(d, 16, options, blocks, nullptr);
+  REQUIRE(hugged.size() == 1);
+  // Whether a pixel centre lies inside the convex quad (either orientation).
+  auto inside = [](const fovea::Quad2d& q, double x, double y) {
+    int positive = 0, negative = 0;
+    for (int c = 0; c < 4; ++c) {
+      const Eigen::Vector2d a = q[c], b = q[(c + 1) % 4];
+      const double cross = (b - a).x() * (y - a.y()) - (b - a).y() * (x - a.x());
+      positive += cross > 1e-9;
+      negative += cross < -1e-9;
+    }
+    return positive == 0 || negative == 0;
+  };
+  int inliers_in = 0, beyond = 0;
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 16; ++x) {
+      if (!inside(hugged[0].corners, x, y)) continue;
+      inliers_in += x >= y - 4;
+      beyond += x < y - 4;
+    }
+  // Four corners cannot follow the inliers' five-sided hull: the quad
+  // leaves out a sliver of them (the pixels under its side from (0, 4) to
+  // the bottom-right corner), but nothing past the edge.
+  INFO("inliers covered " << inliers_in << " of 190");
+  CHECK(inliers_in >= 160);
+  CHECK(beyond == 0);
+  // The bounding box (the default) reaches over the whole lower triangle.
+  blocks.clip_diagonals = false;
+  const auto boxed = fovea::FitBlocks(d, 16, options, blocks, nullptr);
+  REQUIRE(boxed.size() == 1);
+  CHECK(boxed[0].footprint.isApprox(Eigen::Vector4d(-0.5, -0.5, 15.5, 15.5)));
+  int boxed_beyond = 0;
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < y - 4; ++x) boxed_beyond += inside(boxed[0].corners, x, y);
+  CHECK(boxed_beyond == 66);
+  // Over a rectangle of inliers both footprints are its box.
+  cv::Mat r(16, 16, CV_32F, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
+  r.colRange(0, 11).setTo(12.f);
+  blocks.clip_diagonals = true;
+  const auto rect = fovea::FitBlocks(r, 16, options, blocks, nullptr);
+  REQUIRE(rect.size() == 1);
+  const fovea::Quad2d box = fovea::BoxQuad(Eigen::Vector4d(-0.5, -0.5, 10.5, 15.5));
+  for (int c = 0; c < 4; ++c) CHECK(rect[0].corners[c].isApprox(box[c]));
+}
+
 TEST_CASE("erosion at disparity jumps drops the nearer side's edge, whatever NaNs lie near",
           "[fovea][patch]") {
   // A nearer surface (disparity 20) left of x = 20, a farther one (10)

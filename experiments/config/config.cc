@@ -285,6 +285,7 @@ void AddFovealParams(RunConfig* c, std::vector<ConfigParam>* params) {
                      {&fp::kFovealMinBlockPx, &x.foveal.blocks.min_block_px},
                      {&fp::kFovealPeripheryMinBlockPx, &x.foveal.periphery_min_block_px},
                      {&fp::kFovealClipToInliers, &x.foveal.blocks.clip_to_inliers},
+                     {&fp::kFovealClipDiagonals, &x.foveal.blocks.clip_diagonals},
                      {&fp::kFovealRectify, &x.foveal.rectify},
                      {&fp::kFovealSkipFovealEdgePx, &x.foveal.skip_foveal_edge_px},
                      {&fp::kFovealFitMinSupport, &x.foveal.plane_fit.min_support},

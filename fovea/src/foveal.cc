@@ -381,8 +381,8 @@ namespace {
 
 // The patch of one fitted block of a level: it spans the block's footprint
 // (the whole block, which tiles the image without cracks, or its inliers'
-// extent), its corners triangulated from both rays; nullopt if a corner's
-// rays do not meet.
+// extent: their bounding box or their diagonal hull), its corners
+// triangulated from both rays; nullopt if a corner's rays do not meet.
 std::optional<Patch> BlockPatch(const rig::StereoFrame& frame, const Level& level,
                                 const BlockFit& b, int fixation) {
   const rig::CameraView& left = frame.left;
@@ -394,12 +394,10 @@ std::optional<Patch> BlockPatch(const rig::StereoFrame& frame, const Level& leve
   p.fixation = fixation;
   p.fit_rms_px = b.fit.rms_px;
   p.support = b.fit.support;
-  const Eigen::Vector4d& f = b.footprint;
-  const double xs[4] = {f(0), f(2), f(2), f(0)};
-  const double ys[4] = {f(1), f(1), f(3), f(3)};
   for (int c = 0; c < 4; ++c) {
-    const double d = b.fit(xs[c], ys[c]) * s;
-    const double u = (xs[c] + 0.5) * s - 0.5, v = (ys[c] + 0.5) * s - 0.5;
+    const double x = b.corners[c].x(), y = b.corners[c].y();
+    const double d = b.fit(x, y) * s;
+    const double u = (x + 0.5) * s - 0.5, v = (y + 0.5) * s - 0.5;
     const auto tri =
         TriangulateMidpoint(PixelRay(left.world_T_camera, left.intrinsics, {u, v}),
                             PixelRay(right.world_T_camera, right.intrinsics, {u - d, v}));
@@ -433,8 +431,12 @@ int LevelPatches(const rig::StereoFrame& frame, const Tessellation& t, const Lev
     return level.rect.contains(centre) && !(level.index > 0 && inner.contains(centre));
   };
   BlockOptions blocks = options.blocks;
-  if (level.index > 0)
+  if (level.index > 0) {
     blocks.min_block_px = std::max(blocks.min_block_px, options.periphery_min_block_px);
+    // A peripheral block's hull, cut at a corner its sparser matches miss,
+    // gave up more right pixels than wrong ones (README, issue 19).
+    blocks.clip_diagonals = false;
+  }
   int added = 0;
   const cv::Mat beside_holes =
       BesideUnmatchedRuns(disparity, options.edge_erosion_px, options.edge_hole_px);

@@ -69,7 +69,8 @@ void PlaneFitOptions::Check(const rig::ParamSpec& min_support_spec,
 
 std::optional<PlaneFit> FitDisparityPlane(const std::vector<DisparitySample>& samples, double x0,
                                           double y0, double size, const PlaneFitOptions& options,
-                                          Eigen::Vector4d* inlier_box) {
+                                          Eigen::Vector4d* inlier_box,
+                                          std::array<Eigen::Vector2d, 4>* inlier_quad) {
   // Centre coordinates on the block for conditioning.
   const double cx = x0 + 0.5 * size, cy = y0 + 0.5 * size;
   std::vector<const DisparitySample*> in_block;
@@ -109,14 +110,24 @@ std::optional<PlaneFit> FitDisparityPlane(const std::vector<DisparitySample>& sa
   bool quadrant[4] = {false, false, false, false};
   double ss = 0;
   Eigen::Vector4d box(1e300, 1e300, -1e300, -1e300);
+  // The bounding inliers' extremes along the diagonals: the least x + y,
+  // the most x - y, the most x + y, the least x - y (the first in the
+  // samples' order on a tie), as (sign of x, sign of y) per corner.
+  constexpr int kSx[4] = {-1, 1, 1, -1}, kSy[4] = {-1, -1, 1, 1};
+  const DisparitySample* extreme[4] = {nullptr, nullptr, nullptr, nullptr};
   for (const DisparitySample* s : inliers) {
     const double r = s->disparity_px - fit(s->x_px, s->y_px);
     ss += r * r;
     fit.max_abs_px = std::max(fit.max_abs_px, std::abs(r));
     quadrant[(s->x_px >= cx ? 1 : 0) + (s->y_px >= cy ? 2 : 0)] = true;
-    if (s->bounds)
+    if (s->bounds) {
       box = Eigen::Vector4d(std::min(box(0), s->x_px), std::min(box(1), s->y_px),
                             std::max(box(2), s->x_px), std::max(box(3), s->y_px));
+      for (int c = 0; c < 4; ++c)
+        if (!extreme[c] || kSx[c] * s->x_px + kSy[c] * s->y_px >
+                               kSx[c] * extreme[c]->x_px + kSy[c] * extreme[c]->y_px)
+          extreme[c] = s;
+    }
   }
   if (options.require_quadrants && !(quadrant[0] && quadrant[1] && quadrant[2] && quadrant[3]))
     return std::nullopt;
@@ -124,7 +135,16 @@ std::optional<PlaneFit> FitDisparityPlane(const std::vector<DisparitySample>& sa
   fit.support = static_cast<int>(inliers.size());
   fit.rms_px = std::sqrt(ss / fit.support);
   if (inlier_box) *inlier_box = box;
+  if (inlier_quad && extreme[0])
+    for (int c = 0; c < 4; ++c)
+      (*inlier_quad)[c] =
+          Eigen::Vector2d(extreme[c]->x_px + 0.5 * kSx[c], extreme[c]->y_px + 0.5 * kSy[c]);
   return fit;
+}
+
+Quad2d BoxQuad(const Eigen::Vector4d& box) {
+  return {Eigen::Vector2d(box(0), box(1)), Eigen::Vector2d(box(2), box(1)),
+          Eigen::Vector2d(box(2), box(3)), Eigen::Vector2d(box(0), box(3))};
 }
 
 namespace {
@@ -144,8 +164,10 @@ void FitBlock(const cv::Mat& disparity, const cv::Mat& unbounded, int bx, int by
     }
   if (samples.empty()) return;
   Eigen::Vector4d box;
+  Quad2d quad;
   const auto fit =
-      FitDisparityPlane(samples, bx, by, size, o, blocks.clip_to_inliers ? &box : nullptr);
+      FitDisparityPlane(samples, bx, by, size, o, blocks.clip_to_inliers ? &box : nullptr,
+                        blocks.clip_to_inliers && blocks.clip_diagonals ? &quad : nullptr);
   // One plane for the whole block when its inliers fill it and it has next
   // to no outliers (measurements of another surface); else its quarters
   // are tried, and a smallest block that is not whole is left out.
@@ -159,6 +181,7 @@ void FitBlock(const cv::Mat& disparity, const cv::Mat& unbounded, int bx, int by
     b.footprint = blocks.clip_to_inliers
                       ? Eigen::Vector4d(box(0) - 0.5, box(1) - 0.5, box(2) + 0.5, box(3) + 0.5)
                       : Eigen::Vector4d(bx - 0.5, by - 0.5, bx + size - 0.5, by + size - 0.5);
+    b.corners = blocks.clip_to_inliers && blocks.clip_diagonals ? quad : BoxQuad(b.footprint);
     out->push_back(b);
     return;
   }

@@ -202,6 +202,12 @@ inline constexpr ParamSpec kFovealClipToInliers{
     "foveal.clip_to_inliers",
     "beyond the paper: a block's patch covers only its inliers' bounding box, not the whole "
     "block (false = the paper's tiling blocks)"};
+inline constexpr ParamSpec kFovealClipDiagonals{
+    "foveal.clip_diagonals",
+    "beyond the paper, with foveal.clip_to_inliers: a fovea block's patch covers only the "
+    "quadrilateral of its inliers' extreme pixels along both diagonals, so that a depth edge "
+    "crossing the block at a slant cuts the patch along it (false = their bounding box; the same "
+    "where the inliers fill a rectangle; peripheral blocks keep the box)"};
 inline constexpr ParamSpec kFovealRectify{
     "foveal.rectify",
     "beyond the paper: servo, tessellate and match in the pair's fixation frame (both images "

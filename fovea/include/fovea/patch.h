@@ -101,9 +101,18 @@ struct DisparitySample {
 /// support, degenerate geometry, or too many samples beyond the tolerance.
 /// `inlier_box`, if given, receives the extent (x0, y0, x1, y1) of the
 /// inliers that bound (DisparitySample::bounds); nullopt if none does.
+/// `inlier_quad`, if given, receives their diagonal hull (DiagonalHull).
 std::optional<PlaneFit> FitDisparityPlane(const std::vector<DisparitySample>& samples, double x0,
                                           double y0, double size, const PlaneFitOptions& options,
-                                          Eigen::Vector4d* inlier_box = nullptr);
+                                          Eigen::Vector4d* inlier_box = nullptr,
+                                          std::array<Eigen::Vector2d, 4>* inlier_quad = nullptr);
+
+/// A footprint's corners in the image, pixel edges, in the order top-left,
+/// top-right, bottom-right, bottom-left.
+using Quad2d = std::array<Eigen::Vector2d, 4>;
+
+/// The corners of a box (x0, y0, x1, y1) as a Quad2d.
+Quad2d BoxQuad(const Eigen::Vector4d& box);
 
 /// One block of a disparity image fitted as one plane.
 struct BlockFit {
@@ -112,6 +121,9 @@ struct BlockFit {
   /// The patch's extent in the image, pixel edges (x0, y0, x1, y1): the
   /// block, or with BlockOptions::clip_to_inliers the inliers' bounding box.
   Eigen::Vector4d footprint = Eigen::Vector4d::Zero();
+  /// The patch's corners in the image: the footprint's, or with
+  /// BlockOptions::clip_diagonals the inliers' diagonal hull.
+  Quad2d corners{};
 };
 
 /// How FitBlocks turns blocks into planes (beyond the paper: its defaults;
@@ -129,6 +141,14 @@ struct BlockOptions {
   /// block whose data stops short of a side (the far side of a depth edge,
   /// unmatched or eroded) does not extrapolate its plane over the rest.
   bool clip_to_inliers = true;
+  /// With clip_to_inliers, a plane covers only the quadrilateral of its
+  /// inliers' extreme pixels along both diagonals (the pixel corner farthest
+  /// up-left, up-right, down-right and down-left), not their bounding box: a
+  /// block that a depth edge crosses at a slant (a sphere's or a box's
+  /// outline) stops at the edge instead of reaching over the other side's
+  /// corner. The same footprint as the box where the inliers fill a
+  /// rectangle.
+  bool clip_diagonals = false;
 };
 
 /// Planes over the blocks of `size` pixels that tile `disparity` (CV_32F,
