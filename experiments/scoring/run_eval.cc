@@ -457,16 +457,15 @@ nlohmann::json BadJson(const ErrorFigures& f) {
 }
 
 nlohmann::json ErrorJson(const ErrorFigures& f) {
-  return {{"pixels", f.pixels},
-          {"bad_share", BadShare(f)},
-          {"bad_nearer_share", BadNearerShare(f)},
-          {"share", f.share},
-          {"median_abs_error_m", Figure(f.pixels, f.median_abs_error_m)},
-          {"mean_abs_error_m", Figure(f.pixels, f.mean_abs_error_m)},
-          {"rmse_m", Figure(f.pixels, f.rmse_m)},
-          {"median_rel_error", Figure(f.pixels, f.median_rel_error)},
-          {"within_1pct", Figure(f.pixels, f.within_1pct)},
-          {"median_error_steps", Figure(f.pixels, f.median_error_steps)}};
+  nlohmann::json j = BadJson(f);
+  j.update({{"share", f.share},
+            {"median_abs_error_m", Figure(f.pixels, f.median_abs_error_m)},
+            {"mean_abs_error_m", Figure(f.pixels, f.mean_abs_error_m)},
+            {"rmse_m", Figure(f.pixels, f.rmse_m)},
+            {"median_rel_error", Figure(f.pixels, f.median_rel_error)},
+            {"within_1pct", Figure(f.pixels, f.within_1pct)},
+            {"median_error_steps", Figure(f.pixels, f.median_error_steps)}});
+  return j;
 }
 }  // namespace
 

@@ -69,8 +69,7 @@ void PlaneFitOptions::Check(const rig::ParamSpec& min_support_spec,
 
 std::optional<PlaneFit> FitDisparityPlane(const std::vector<DisparitySample>& samples, double x0,
                                           double y0, double size, const PlaneFitOptions& options,
-                                          Eigen::Vector4d* inlier_box,
-                                          std::array<Eigen::Vector2d, 4>* inlier_quad) {
+                                          Eigen::Vector4d* inlier_box, Quad2d* inlier_quad) {
   // Centre coordinates on the block for conditioning.
   const double cx = x0 + 0.5 * size, cy = y0 + 0.5 * size;
   std::vector<const DisparitySample*> in_block;
@@ -165,9 +164,9 @@ void FitBlock(const cv::Mat& disparity, const cv::Mat& unbounded, int bx, int by
   if (samples.empty()) return;
   Eigen::Vector4d box;
   Quad2d quad;
-  const auto fit =
-      FitDisparityPlane(samples, bx, by, size, o, blocks.clip_to_inliers ? &box : nullptr,
-                        blocks.clip_to_inliers && blocks.clip_diagonals ? &quad : nullptr);
+  const bool hull = blocks.clip_to_inliers && blocks.clip_diagonals;
+  const auto fit = FitDisparityPlane(
+      samples, bx, by, size, o, blocks.clip_to_inliers ? &box : nullptr, hull ? &quad : nullptr);
   // One plane for the whole block when its inliers fill it and it has next
   // to no outliers (measurements of another surface); else its quarters
   // are tried, and a smallest block that is not whole is left out.
@@ -181,7 +180,7 @@ void FitBlock(const cv::Mat& disparity, const cv::Mat& unbounded, int bx, int by
     b.footprint = blocks.clip_to_inliers
                       ? Eigen::Vector4d(box(0) - 0.5, box(1) - 0.5, box(2) + 0.5, box(3) + 0.5)
                       : Eigen::Vector4d(bx - 0.5, by - 0.5, bx + size - 0.5, by + size - 0.5);
-    b.corners = blocks.clip_to_inliers && blocks.clip_diagonals ? quad : BoxQuad(b.footprint);
+    b.corners = hull ? quad : BoxQuad(b.footprint);
     out->push_back(b);
     return;
   }

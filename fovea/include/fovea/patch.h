@@ -96,20 +96,22 @@ struct DisparitySample {
   bool bounds = true;
 };
 
+/// A footprint's corners in the image, pixel edges, in the order top-left,
+/// top-right, bottom-right, bottom-left.
+using Quad2d = std::array<Eigen::Vector2d, 4>;
+
 /// Trimmed least-squares plane over the samples that fall in the block
 /// [x0, x0 + size) x [y0, y0 + size). nullopt if the block has too little
 /// support, degenerate geometry, or too many samples beyond the tolerance.
 /// `inlier_box`, if given, receives the extent (x0, y0, x1, y1) of the
 /// inliers that bound (DisparitySample::bounds); nullopt if none does.
-/// `inlier_quad`, if given, receives their diagonal hull (DiagonalHull).
+/// `inlier_quad`, if given, receives their diagonal hull: the pixel corners
+/// farthest up-left, up-right, down-right and down-left of them
+/// (BlockOptions::clip_diagonals).
 std::optional<PlaneFit> FitDisparityPlane(const std::vector<DisparitySample>& samples, double x0,
                                           double y0, double size, const PlaneFitOptions& options,
                                           Eigen::Vector4d* inlier_box = nullptr,
-                                          std::array<Eigen::Vector2d, 4>* inlier_quad = nullptr);
-
-/// A footprint's corners in the image, pixel edges, in the order top-left,
-/// top-right, bottom-right, bottom-left.
-using Quad2d = std::array<Eigen::Vector2d, 4>;
+                                          Quad2d* inlier_quad = nullptr);
 
 /// The corners of a box (x0, y0, x1, y1) as a Quad2d.
 Quad2d BoxQuad(const Eigen::Vector4d& box);
