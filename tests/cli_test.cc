@@ -93,8 +93,22 @@ TEST_CASE("fovea bench fixation prints the figures scripts rely on", "[cli][slow
   std::string line;
   std::getline(in, line);
   for (const char* key : {"\"foveated_ms\"", "\"full_res_ms\"", "\"sgbm_ms\"",
-                          "\"foveal_error_px\"", "\"full_res_error_px\"", "\"sgbm_error_px\""})
+                          "\"foveal_error_px\"", "\"full_res_error_px\"", "\"sgbm_error_px\"",
+                          "\"full_res_over_foveated\"", "\"sgbm_over_foveated\""})
     CHECK(line.find(key) != std::string::npos);
+  // The breakdown of the median repeat: a time and a pixel count per
+  // level, adding up with the wide search's time to the whole.
+  const nlohmann::json j = nlohmann::json::parse(line);
+  const auto& levels = j.at("level_ms");
+  REQUIRE(levels.size() == j.at("levels").get<size_t>());
+  REQUIRE(j.at("level_searched_px").size() == levels.size());
+  double parts = j.at("silent_check_ms").get<double>();
+  for (size_t l = 0; l < levels.size(); ++l) {
+    CHECK(levels[l].get<double>() > 0);
+    CHECK(j.at("level_searched_px")[l].get<int>() > 0);
+    parts += levels[l].get<double>();
+  }
+  CHECK(parts == Approx(j.at("foveated_ms").get<double>()).epsilon(1e-9));
   fs::remove_all(out);
 }
 
