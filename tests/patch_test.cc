@@ -330,6 +330,22 @@ TEST_CASE("erosion at disparity jumps drops the nearer side's edge, whatever NaN
     }
   CHECK(n == expected);
   CHECK(expected > 0);
+  // The same data in a corner of a larger, otherwise unmatched level (as a
+  // fovea lies in its level's image), near the border or not: the same
+  // pixels go.
+  for (const cv::Point at : {cv::Point(0, 0), cv::Point(30, 17), cv::Point(60, 36)}) {
+    INFO("at " << at);
+    cv::Mat large(60, 100, CV_32F, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
+    d.copyTo(large(cv::Rect(at, d.size())));
+    CHECK(fovea::ErodeAtDisparityJumps(3, 1.5, &large) == n);
+    int differ = 0;
+    for (int y = 0; y < d.rows; ++y)
+      for (int x = 0; x < d.cols; ++x) {
+        const float a = large.at<float>(at.y + y, at.x + x), b = eroded.at<float>(y, x);
+        differ += !(a == b || (std::isnan(a) && std::isnan(b)));
+      }
+    CHECK(differ == 0);
+  }
 }
 
 TEST_CASE("matches beside a wide unmatched stretch are found along rows and columns",

@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "fovea/geometry.h"
 #include "test_views.h"
 
 namespace {
@@ -186,4 +187,63 @@ TEST_CASE("holes in the map take the nearest mapped depth and can be fixated",
   CHECK(s_filled.pixel.x() >= 80);
   CHECK(s_filled.in_hole);
   CHECK(s_filled.point_W.y() == Approx(2.0).margin(1e-6));
+}
+
+TEST_CASE("selection at a reduced resolution: the same rays, sizes in full-resolution pixels",
+          "[fovea][selection]") {
+  rig::CameraView full = View();
+  full.gray = HalfTextured();
+  for (const int level : {1, 2}) {
+    INFO("level " << level);
+    const rig::CameraView reduced = fovea::ReducedView(full, level);
+    CHECK(reduced.intrinsics.width_px == 160 >> level);
+    CHECK(reduced.intrinsics.height_px == 120 >> level);
+    CHECK(reduced.gray.size() == cv::Size(160 >> level, 120 >> level));
+    // Each reduced pixel looks along the ray of its block's centre.
+    for (const Eigen::Vector2d& p : {Eigen::Vector2d(0, 0), Eigen::Vector2d(7, 3),
+                                     Eigen::Vector2d(reduced.intrinsics.width_px - 1, 10)}) {
+      const Eigen::Vector2d q = fovea::FullResolutionPixel(p, level);
+      const double n = 1 << level;
+      CHECK(q.x() == Approx(n * p.x() + (n - 1) / 2));
+      const fovea::Ray a = fovea::PixelRay(reduced.world_T_camera, reduced.intrinsics, p);
+      const fovea::Ray b = fovea::PixelRay(full.world_T_camera, full.intrinsics, q);
+      CHECK((a.direction_W - b.direction_W).norm() < 1e-12);
+    }
+    // The image is averaged over the blocks: the texture stays on the right.
+    CHECK(reduced.gray.at<uchar>(5, 2) == 128);
+  }
+  fovea::SelectionOptions selection;
+  fovea::CriteriaOptions criteria;
+  fovea::AtResolutionLevel(1, &selection, &criteria);
+  CHECK(selection.border_px == 8);
+  CHECK(selection.fovea_size_px == 64);
+  CHECK(criteria.gradient_blur_px == 1.0);
+  CHECK(criteria.proximity_2d_scale_px == 160);
+  selection.fovea_size_px = 8;  // the smallest allowed stays
+  fovea::AtResolutionLevel(2, &selection, &criteria);
+  CHECK(selection.fovea_size_px == 8);
+  CHECK(selection.border_px == 2);
+  CHECK_NOTHROW(selection.Check());
+
+  // Chosen in the reduced view, the deterministic maximum still lies on the
+  // texture, and its full-resolution pixel ray hits the map where the
+  // choice's point says.
+  fovea::PatchMap map;
+  map.Add(Square(-1, 0, -1, 1, 1.0, fovea::PatchLevel::kFoveal));
+  map.Add(Square(0, 1, -1, 1, 1.0, fovea::PatchLevel::kIdr));
+  const rig::CameraView reduced = fovea::ReducedView(full, 1);
+  const fovea::SelectionContext c =
+      fovea::SelectionContext::Make(reduced.gray, reduced, map, false);
+  fovea::SelectionOptions o;
+  fovea::CriteriaOptions co;
+  o.deterministic = true;
+  fovea::AtResolutionLevel(1, &o, &co);
+  std::mt19937_64 rng(1);
+  const auto s = fovea::FixationSelector(co.Make(), o).Choose(c, map, {}, &rng);
+  REQUIRE(s.ok);
+  const Eigen::Vector2d q = fovea::FullResolutionPixel(s.pixel, 1);
+  CHECK(q.x() >= 80);
+  const fovea::Ray ray = fovea::PixelRay(full.world_T_camera, full.intrinsics, q);
+  CHECK((ray.origin_W + ray.direction_W * ((s.point_W - ray.origin_W).norm()) - s.point_W).norm() <
+        1e-9);
 }

@@ -330,6 +330,7 @@ void AddDdrParams(RunConfig* c, std::vector<ConfigParam>* params) {
           {&fp::kSelectionDrawScale, &f.selection.draw_scale},
           {&fp::kSelectionHistogramBins, &f.selection.histogram_bins},
           {&fp::kSelectionBorderPx, &f.selection.border_px},
+          {&fp::kSelectionResolutionLevel, &f.selection.resolution_level},
           {&fp::kSelectionRefusedRadiusM, &f.selection.refused_radius_m},
           {&fp::kCriteriaGradient, &f.criteria.gradient},
           {&fp::kCriteriaSuppression, &f.criteria.suppression},

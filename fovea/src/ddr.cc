@@ -94,8 +94,9 @@ SelectionSummary ChooseTarget(const FoveaRun& run, LoopState& state, FixationStr
   const bool in_reference = strategy.View() == StrategyView::kReference;
   const rig::StereoFrame& frame = in_reference ? run.idr.final_frame : state.frame;
   const bool same_context = state.context.has_value();
+  const int level = options.selection.resolution_level;
   if (!same_context) {
-    const rig::CameraView& view = frame.left;
+    const rig::CameraView view = level > 0 ? ReducedView(frame.left, level) : frame.left;
     SelectionContext& context = state.context.emplace(
         SelectionContext::Make(view.gray, view, run.map, options.fixate_holes));
     context.eye_W = state.frame.left.world_T_camera;
@@ -107,13 +108,17 @@ SelectionSummary ChooseTarget(const FoveaRun& run, LoopState& state, FixationStr
     if (options.stay_in_idr_view && !in_reference) context.region = run.idr.final_frame.left;
   }
   constexpr int kMaxPrescreened = 8;
-  return strategy.ChooseAccepted(
+  SelectionSummary chosen = strategy.ChooseAccepted(
       *state.context, run.map, &state.refused, rng,
       [&](const SelectionSummary& s) {
         return !s.in_hole || !options.prescreen_holes ||
-               UniqueAlongRay(frame, s.pixel, hole_depths, options.fixation.servo);
+               UniqueAlongRay(frame, FullResolutionPixel(s.pixel, level), hole_depths,
+                              options.fixation.servo);
       },
       kMaxPrescreened, same_context);
+  // The record gives the pixel of the full-resolution view.
+  if (chosen.ok) chosen.pixel = FullResolutionPixel(chosen.pixel, level);
+  return chosen;
 }
 
 // Total travel of each kind of axis between two stage states, both cameras
@@ -200,8 +205,12 @@ FoveaRun RunFovea(rig::Rig& rig, const StereoMatcher& matcher, const FoveaOption
   options.Check();  // once: nothing below checks again
   FoveaRun run;
   std::mt19937_64 rng(options.seed);
-  const std::unique_ptr<FixationStrategy> strategy =
-      MakeStrategy(options.selection, options.criteria);
+  // The strategy chooses in the view reduced by the selection's resolution
+  // level, with its pixel sizes at that level.
+  SelectionOptions selection = options.selection;
+  CriteriaOptions criteria = options.criteria;
+  AtResolutionLevel(selection.resolution_level, &selection, &criteria);
+  const std::unique_ptr<FixationStrategy> strategy = MakeStrategy(selection, criteria);
   const FixationOptions fixation_options = ResolvedFixationOptions(options);
   run.idr = RunIdr(rig, options.idr);
   run.map = run.idr.map;

@@ -318,12 +318,24 @@ int DropOutsideBand(const SilentCheck& check, const Level& level, const SearchRa
 
 int ErodeAtDisparityJumps(int radius, double jump_px, cv::Mat* disparity) {
   if (radius <= 0) return 0;
+  // Only the matched pixels' bounding box and `radius` around it can change
+  // (elsewhere the limit is +inf, as beyond the image's border): the fovea's
+  // level is mostly unmatched.
+  cv::Rect box;
+  for (int y = 0; y < disparity->rows; ++y) {
+    const float* row = disparity->ptr<float>(y);
+    for (int x = 0; x < disparity->cols; ++x)
+      if (std::isfinite(row[x])) box |= cv::Rect(x, y, 1, 1);
+  }
+  if (box.empty()) return 0;
+  box = cv::Rect(box.x - radius, box.y - radius, box.width + 2 * radius, box.height + 2 * radius) &
+        cv::Rect(0, 0, disparity->cols, disparity->rows);
+  cv::Mat d = (*disparity)(box);
   // The limits: each pixel's disparity where it belongs to a surface, at
   // least kSupport of its 8 neighbours within jump_px of it; +inf (no limit)
   // where it is NaN or an isolated mismatch, which would otherwise cost the
   // good matches around it.
   constexpr int kSupport = 3;
-  const cv::Mat& d = *disparity;
   cv::Mat farthest(d.size(), CV_32F, cv::Scalar(std::numeric_limits<float>::infinity()));
   for (int y = 0; y < d.rows; ++y)
     for (int x = 0; x < d.cols; ++x) {
@@ -338,11 +350,11 @@ int ErodeAtDisparityJumps(int radius, double jump_px, cv::Mat* disparity) {
   cv::erode(farthest, farthest,
             cv::getStructuringElement(cv::MORPH_RECT, {2 * radius + 1, 2 * radius + 1}));
   int n = 0;
-  for (int y = 0; y < disparity->rows; ++y)
-    for (int x = 0; x < disparity->cols; ++x) {
-      float& d = disparity->at<float>(y, x);
-      if (std::isfinite(d) && d - farthest.at<float>(y, x) > jump_px) {
-        d = std::numeric_limits<float>::quiet_NaN();
+  for (int y = 0; y < d.rows; ++y)
+    for (int x = 0; x < d.cols; ++x) {
+      float& here = d.at<float>(y, x);
+      if (std::isfinite(here) && here - farthest.at<float>(y, x) > jump_px) {
+        here = std::numeric_limits<float>::quiet_NaN();
         ++n;
       }
     }

@@ -249,6 +249,7 @@ void SelectionOptions::Check() const {
   rig::CheckParam(params::kSelectionDrawScale, draw_scale);
   rig::CheckParam(params::kSelectionHistogramBins, histogram_bins);
   rig::CheckParam(params::kSelectionBorderPx, border_px);
+  rig::CheckParam(params::kSelectionResolutionLevel, resolution_level);
   rig::CheckParam(params::kSelectionRefusedRadiusM, refused_radius_m);
 }
 
@@ -339,6 +340,38 @@ cv::Mat FixationSelector::Composite(const SelectionContext& c, const Weights& w,
   composite.setTo(0.0, candidates == 0);
   NormalizeSum(&composite);
   return composite;
+}
+
+void AtResolutionLevel(int level, SelectionOptions* selection, CriteriaOptions* criteria) {
+  const double s = std::ldexp(1.0, -level);
+  auto scaled = [&](int px, double smallest) {
+    return static_cast<int>(std::max(smallest, std::round(px * s)));
+  };
+  selection->border_px = scaled(selection->border_px, params::kSelectionBorderPx.lo);
+  selection->fovea_size_px = scaled(selection->fovea_size_px, params::kSelectionFoveaSizePx.lo);
+  criteria->gradient_blur_px *= s;
+  criteria->proximity_2d_scale_px *= s;
+}
+
+rig::CameraView ReducedView(const rig::CameraView& view, int level) {
+  rig::CameraView reduced = view;
+  const double s = std::ldexp(1.0, -level);
+  rig::CameraIntrinsics& k = reduced.intrinsics;
+  k.width_px = view.intrinsics.width_px >> level;
+  k.height_px = view.intrinsics.height_px >> level;
+  k.fx_px *= s;
+  k.fy_px *= s;
+  k.cx_px = (view.intrinsics.cx_px + 0.5) * s - 0.5;
+  k.cy_px = (view.intrinsics.cy_px + 0.5) * s - 0.5;
+  if (!view.gray.empty())
+    cv::resize(view.gray, reduced.gray, cv::Size(k.width_px, k.height_px), 0, 0, cv::INTER_AREA);
+  reduced.bgr.release();
+  return reduced;
+}
+
+Eigen::Vector2d FullResolutionPixel(const Eigen::Vector2d& pixel, int level) {
+  const double n = std::ldexp(1.0, level);
+  return (pixel.array() + 0.5) * n - 0.5;
 }
 
 double DrawExponential(double r, double s) {

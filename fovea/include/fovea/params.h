@@ -297,6 +297,11 @@ inline constexpr ParamSpec kSelectionDrawScale{"selection.draw_scale",
                                                "scale s of the exponential draw", 0.001, 100};
 inline constexpr ParamSpec kSelectionHistogramBins{"selection.histogram_bins",
                                                    "bins of the composite's histogram", 2, 4096};
+inline constexpr ParamSpec kSelectionResolutionLevel{
+    "selection.resolution_level",
+    "beyond the paper: the criteria are weighed on the view reduced 2^level times in each "
+    "direction (0 = full resolution; pixel sizes stay in full-resolution pixels)",
+    0, 2};
 inline constexpr ParamSpec kSelectionBorderPx{
     "selection.border_px", "fixation candidates keep this far from the image edge, pixels", 0, 200};
 inline constexpr ParamSpec kSelectionRefusedRadiusM{

@@ -177,6 +177,14 @@ struct SelectionOptions {
   double draw_scale = 0.5;  ///< s of the exponential draw
   int histogram_bins = 64;
   int border_px = 16;  ///< candidates keep this far from the image edge
+  /// Beyond the paper: the criteria are weighed on the view reduced
+  /// 2^resolution_level times in each direction (the chosen pixel is the
+  /// centre of its block at full resolution; 0 = the paper's full
+  /// resolution). The criteria are smooth over many pixels, and a choice at
+  /// full resolution cost 40% of a fixation's compute (README). Pixel sizes
+  /// here and in CriteriaOptions stay in full-resolution pixels
+  /// (AtResolutionLevel).
+  int resolution_level = 1;
   /// Candidates whose map point lies within this distance of a point that
   /// could not be fixated are left out.
   double refused_radius_m = 0.03;
@@ -192,6 +200,21 @@ struct SelectionOptions {
   /// The strategy in force: "deterministic" when `deterministic` is set.
   std::string Strategy() const;
 };
+
+/// The options for choosing in a view reduced 2^level times: their pixel
+/// sizes (the border, the fovea's size, the gradient's blur and 2D
+/// proximity's scale) divided by 2^level, the integer ones rounded and kept
+/// at least their smallest allowed value.
+void AtResolutionLevel(int level, SelectionOptions* selection, CriteriaOptions* criteria);
+
+/// `view` reduced 2^level times in each direction: the same rays through
+/// the centres of its blocks of 2^level x 2^level pixels (the image size
+/// rounded down). The lens's distortion, in normalized coordinates, stays.
+rig::CameraView ReducedView(const rig::CameraView& view, int level);
+
+/// A pixel of the view ReducedView(view, level) as the full-resolution
+/// pixel at the centre of its block.
+Eigen::Vector2d FullResolutionPixel(const Eigen::Vector2d& pixel, int level);
 
 /// What one choice looked like, for the records.
 struct SelectionSummary {
