@@ -67,6 +67,26 @@ TEST_CASE("plane fitting drops outliers and rejects mixed or thin support", "[fo
   CHECK_FALSE(fovea::FitDisparityPlane(corner, 0, 0, 16, {}));
 }
 
+TEST_CASE("a patch's view angle: 0 face on, growing as it turns edge on", "[fovea][patch]") {
+  const fovea::Patch face = Square(1.0, 0.05);
+  CHECK(face.ViewAngleRad(Eigen::Vector3d::Zero()) == Approx(0).margin(1e-12));
+  // Seen from behind: the same angle (the corner order does not matter).
+  CHECK(face.ViewAngleRad(Eigen::Vector3d(0, 0, 2)) == Approx(0).margin(1e-12));
+  // Turned about the y axis through its centre, seen from the origin along z.
+  for (const double deg : {30.0, 70.0, 85.0}) {
+    const Eigen::AngleAxisd turn(deg * M_PI / 180, Eigen::Vector3d::UnitY());
+    fovea::Patch turned = face;
+    for (auto& c : turned.corners_W)
+      c = Eigen::Vector3d(0, 0, 1) + turn * (c - Eigen::Vector3d(0, 0, 1));
+    CHECK(turned.ViewAngleRad(Eigen::Vector3d::Zero()) == Approx(deg * M_PI / 180).epsilon(1e-9));
+  }
+  // Off the axis, the line of sight counts, not the camera's axis: a wall
+  // at z = 1 seen 45 degrees off to the side.
+  fovea::Patch side = Square(1.0, 0.05);
+  for (auto& c : side.corners_W) c.x() += 1.0;
+  CHECK(side.ViewAngleRad(Eigen::Vector3d::Zero()) == Approx(M_PI / 4).epsilon(1e-9));
+}
+
 TEST_CASE("patch map: rays hit the nearest patch", "[fovea][patch]") {
   fovea::PatchMap map;
   map.Add(Square(2.0, 0.5));

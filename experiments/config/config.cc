@@ -288,6 +288,7 @@ void AddFovealParams(RunConfig* c, std::vector<ConfigParam>* params) {
                      {&fp::kFovealClipDiagonals, &x.foveal.blocks.clip_diagonals},
                      {&fp::kFovealRectify, &x.foveal.rectify},
                      {&fp::kFovealSkipFovealEdgePx, &x.foveal.skip_foveal_edge_px},
+                     {&fp::kFovealMaxViewAngleDeg, &x.foveal.max_view_angle_deg},
                      {&fp::kFovealFitMinSupport, &x.foveal.plane_fit.min_support},
                      {&fp::kFovealFitTolerancePx, &x.foveal.plane_fit.fit_tolerance_px},
                      {&fp::kFovealFitMinInlierShare, &x.foveal.plane_fit.min_inlier_share},

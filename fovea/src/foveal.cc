@@ -32,6 +32,7 @@ void FovealOptions::Check() const {
   // Set from idr.z_min_m (ResolvedFixationOptions), not a parameter of its own.
   if (!(silent_near_m >= 0)) throw rig::InputError("foveal options: silent_near_m must be >= 0");
   rig::CheckParam(params::kFovealSkipFovealEdgePx, skip_foveal_edge_px);
+  rig::CheckParam(params::kFovealMaxViewAngleDeg, max_view_angle_deg);
 }
 
 void FixationOptions::Check() const {
@@ -396,7 +397,7 @@ namespace {
 // extent: their bounding box or their diagonal hull), its corners
 // triangulated from both rays; nullopt if a corner's rays do not meet.
 std::optional<Patch> BlockPatch(const rig::StereoFrame& frame, const Level& level,
-                                const BlockFit& b, int fixation) {
+                                const BlockFit& b, int fixation, double max_view_angle_deg) {
   const rig::CameraView& left = frame.left;
   const rig::CameraView& right = frame.right;
   const double s = level.scale;
@@ -419,6 +420,9 @@ std::optional<Patch> BlockPatch(const rig::StereoFrame& frame, const Level& leve
   // Matching precision and fit residual, in level pixels, at the level's scale.
   SetDepthSigma(&p, left, right.world_T_camera.translation(),
                 s * std::max(kMatchSigmaPx, b.fit.rms_px));
+  if (max_view_angle_deg > 0 &&
+      !(p.ViewAngleRad(left.world_T_camera.translation()) <= max_view_angle_deg * M_PI / 180))
+    return std::nullopt;
   return p;
 }
 
@@ -453,7 +457,7 @@ int LevelPatches(const rig::StereoFrame& frame, const Tessellation& t, const Lev
   const cv::Mat beside_holes =
       BesideUnmatchedRuns(disparity, options.edge_erosion_px, options.edge_hole_px);
   for (const BlockFit& b : FitBlocks(disparity, size, fit_options, blocks, in_level, beside_holes))
-    if (const auto p = BlockPatch(frame, level, b, fixation)) {
+    if (const auto p = BlockPatch(frame, level, b, fixation, options.max_view_angle_deg)) {
       patches->Add(*p);
       ++added;
     }

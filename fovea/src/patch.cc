@@ -27,6 +27,11 @@ Eigen::Vector3d Patch::Normal() const {
   return (corners_W[2] - corners_W[0]).cross(corners_W[3] - corners_W[1]).normalized();
 }
 
+double Patch::ViewAngleRad(const Eigen::Vector3d& eye_W) const {
+  const double c = std::abs(Normal().dot((Centre() - eye_W).normalized()));
+  return std::acos(std::min(1.0, c));
+}
+
 double Patch::SizeM() const {
   return std::max((corners_W[2] - corners_W[0]).norm(), (corners_W[3] - corners_W[1]).norm());
 }

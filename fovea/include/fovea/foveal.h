@@ -89,6 +89,16 @@ struct FovealOptions {
   /// side's depth into peripheral blocks that straddle the edge. 0: every
   /// pixel of every level.
   int skip_foveal_edge_px = 0;
+  /// Beyond the paper (issue 19): with this > 0 a block gives no patch when
+  /// its plane is seen more obliquely than this, degrees between its normal
+  /// and the left camera's line of sight to its centre (Patch::ViewAngleRad).
+  /// Window matching assumes a surface seen face on; seen obliquely, the two
+  /// cameras foreshorten its texture differently (at 1 m the 0.06 m pair's
+  /// lines of sight differ by 3.4 degrees: one image stretches the texture
+  /// 16-20% more than the other at 70 degrees, 4% at 30), and at a curved
+  /// surface's grazing limb the plane lands 1-5% too far. 0: any angle, the
+  /// paper's rule (README, "The map's trust").
+  double max_view_angle_deg = 70;
   void Check() const;  ///< throws rig::InputError naming the key (fovea/params.h)
 };
 

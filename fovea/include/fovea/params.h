@@ -219,6 +219,11 @@ inline constexpr ParamSpec kFovealSkipFovealEdgePx{
     "rectangle where the map shows a foveal patch within this many pixels of a depth jump or a "
     "hole in the map (0 = match every pixel of every level)",
     0, 64};
+inline constexpr ParamSpec kFovealMaxViewAngleDeg{
+    "foveal.max_view_angle_deg",
+    "beyond the paper: a block gives no patch when its plane is seen more obliquely than this, "
+    "degrees between its normal and the left camera's ray to its centre (0 = any)",
+    0, 90};
 inline constexpr ParamSpec kFovealFitMinSupport{
     "foveal.fit_min_support",
     "foveal and peripheral patch fit: inlier measurements needed in a block", 3, 4096};

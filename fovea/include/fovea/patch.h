@@ -41,6 +41,9 @@ struct Patch {
   Eigen::Vector3d Normal() const;
   /// Diameter: the longer diagonal, metres.
   double SizeM() const;
+  /// The angle between its plane's normal and the line of sight from
+  /// `eye_W` to its centre, radians: 0 seen face on, pi/2 edge on.
+  double ViewAngleRad(const Eigen::Vector3d& eye_W) const;
 };
 
 /// Matching precision of a well-textured window at full resolution, pixels
