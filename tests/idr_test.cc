@@ -150,3 +150,33 @@ TEST_CASE("patches from disparities back-project to the right depth", "[fovea][i
     CHECK(p.level == fovea::PatchLevel::kIdr);
   }
 }
+
+TEST_CASE("IDR blocks whose plane is seen too obliquely give no patch", "[fovea][idr]") {
+  rig::CameraView view;
+  view.intrinsics = rig::CameraIntrinsics::FromHorizontalFov(128, 96, 0.6);
+  const rig::CameraIntrinsics& k = view.intrinsics;
+  // A plane through (0, 0, z0) turned 70 degrees about the vertical axis:
+  // 1 / Z = (1 + u tan 70) / z0 along the ray (u, v, 1), so the view angle
+  // runs from about 50 degrees at the right edge to 90 at the left.
+  const double baseline = 0.05, z0 = 0.8, slope = std::tan(70 * M_PI / 180);
+  std::vector<fovea::DisparitySample> samples;
+  for (int y = 0; y < 96; ++y)
+    for (int x = 0; x < 128; x += 2) {
+      const double u = (x + 0.2 - k.cx_px) / k.fx_px;
+      const double d = k.fx_px * baseline * (1 + u * slope) / z0;
+      if (d > 0.5) samples.push_back({x + 0.2, double(y), d});
+    }
+  const Eigen::Vector3d eye_W = view.world_T_camera.translation();
+  const fovea::PatchMap any =
+      fovea::PatchesFromDisparities(samples, view, baseline, 16, {}, fovea::PatchLevel::kIdr);
+  const fovea::PatchMap limited =
+      fovea::PatchesFromDisparities(samples, view, baseline, 16, {}, fovea::PatchLevel::kIdr, 60);
+  size_t within = 0;
+  for (const auto& p : any.patches()) within += p.ViewAngleRad(eye_W) <= 60 * M_PI / 180;
+  INFO(any.size() << " patches, " << within << " within 60 degrees, " << limited.size()
+                  << " with the limit");
+  CHECK(within >= 6);
+  CHECK(any.size() >= within + 6);
+  CHECK(limited.size() == within);
+  for (const auto& p : limited.patches()) CHECK(p.ViewAngleRad(eye_W) <= 60 * M_PI / 180);
+}

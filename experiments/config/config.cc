@@ -252,6 +252,7 @@ void AddIdrParams(RunConfig* c, std::vector<ConfigParam>* params) {
                      {&fp::kIdrFitTolerancePx, &f.idr.plane_fit.fit_tolerance_px},
                      {&fp::kIdrFitMinInlierShare, &f.idr.plane_fit.min_inlier_share},
                      {&fp::kIdrFitRequireQuadrants, &f.idr.plane_fit.require_quadrants},
+                     {&fp::kIdrMaxViewAngleDeg, &f.idr.max_view_angle_deg},
                  });
 }
 

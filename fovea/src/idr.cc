@@ -225,6 +225,7 @@ void IdrOptions::Check() const {
   matching.Check();
   rig::CheckParam(params::kIdrUniqueShare, unique_share);
   rig::CheckParam(params::kIdrZMinM, z_min_m);
+  rig::CheckParam(params::kIdrMaxViewAngleDeg, max_view_angle_deg);
   rig::CheckParam(params::kIdrMaxSlantDeg, max_slant_deg);
   rig::CheckParam(params::kIdrMaxExpansion, max_expansion);
   rig::CheckParam(params::kIdrMinExpansion, min_expansion);
@@ -244,7 +245,8 @@ void IdrOptions::Check() const {
 
 PatchMap PatchesFromDisparities(const std::vector<DisparitySample>& samples,
                                 const rig::CameraView& left, double baseline_m, int patch_size_px,
-                                const PlaneFitOptions& options, PatchLevel level) {
+                                const PlaneFitOptions& options, PatchLevel level,
+                                double max_view_angle_deg) {
   PatchMap map;
   const rig::CameraIntrinsics& k = left.intrinsics;
   // Bucket samples by block so each fit sees only its own.
@@ -293,6 +295,9 @@ PatchMap PatchesFromDisparities(const std::vector<DisparitySample>& samples,
       const Eigen::Vector3d right_W =
           left.world_T_camera.translation() + baseline_m * left.world_T_camera.linear().col(0);
       SetDepthSigma(&p, left, right_W, std::max(0.5, fit->rms_px));
+      if (max_view_angle_deg > 0 &&
+          !(p.ViewAngleRad(left.world_T_camera.translation()) <= max_view_angle_deg * M_PI / 180))
+        continue;
       map.Add(p);
     }
   }
@@ -503,9 +508,9 @@ IdrResult RunIdr(rig::Rig& rig, const IdrOptions& options) {
     result.final_frame = frame;
     result.final_samples = stage_samples.samples;
     result.final_unmatched = std::move(stage_samples.unmatched);
-    result.map =
-        PatchesFromDisparities(SmoothSamples(stage_samples.samples, options), frame.left, b,
-                               options.patch_size_px, options.plane_fit, PatchLevel::kIdr);
+    result.map = PatchesFromDisparities(SmoothSamples(stage_samples.samples, options), frame.left,
+                                        b, options.patch_size_px, options.plane_fit,
+                                        PatchLevel::kIdr, options.max_view_angle_deg);
     ChooseFirstFixation(frame.left, options, &result);
     const double expansion = NextExpansion(stage, s + 1 == options.max_stages, !matches.empty(), f,
                                            max_baseline, options, &result);

@@ -106,6 +106,11 @@ struct IdrOptions {
   int max_stages = 6;  ///< budget: IDR always ends
   int patch_size_px = 16;
   PlaneFitOptions plane_fit;
+  /// Beyond the paper (issue 19): blocks whose plane is seen more obliquely
+  /// than this, degrees, give no patch (as foveal.max_view_angle_deg; the
+  /// expansion rule above already assumes no steeper slant); 0: any angle,
+  /// the paper's rule (README, "The map's trust").
+  double max_view_angle_deg = 60;
   /// Matches with a neighbour within 2 sigma whose disparity differs by more
   /// than this lie at a depth discontinuity, where the LoG's blur displaces
   /// the crossings: they are left out of the patches.
@@ -150,8 +155,11 @@ IdrResult RunIdr(rig::Rig& rig, const IdrOptions& options);
 /// one per patch_size block that fits, each cut back to half a pixel beyond
 /// its inliers' extent (so that it never reaches over a depth step where the
 /// features stop short of the edge); corners back-projected with Z = f B / d.
+/// With max_view_angle_deg > 0, a block whose plane is seen more obliquely
+/// than that from the left camera gives no patch (Patch::ViewAngleRad).
 PatchMap PatchesFromDisparities(const std::vector<DisparitySample>& samples,
                                 const rig::CameraView& left, double baseline_m, int patch_size_px,
-                                const PlaneFitOptions& options, PatchLevel level);
+                                const PlaneFitOptions& options, PatchLevel level,
+                                double max_view_angle_deg = 0);
 
 }  // namespace fovea

@@ -71,6 +71,11 @@ inline constexpr ParamSpec kIdrFitTolerancePx{
 inline constexpr ParamSpec kIdrFitMinInlierShare{
     "idr.fit_min_inlier_share",
     "IDR patch fit: a block needs this share of its measurements as inliers", 0, 1};
+inline constexpr ParamSpec kIdrMaxViewAngleDeg{
+    "idr.max_view_angle_deg",
+    "beyond the paper: an IDR block gives no patch when its plane is seen more obliquely than "
+    "this, degrees between its normal and the left camera's ray to its centre (0 = any)",
+    0, 90};
 inline constexpr ParamSpec kIdrFitRequireQuadrants{
     "idr.fit_require_quadrants", "IDR patch fit: a block needs measurements in all four quadrants"};
 
