@@ -195,6 +195,60 @@ TEST_CASE("the fixation frame of a tilted verged pair is a level pair's",
   CHECK(original_area < 0.3 * level_area);
 }
 
+TEST_CASE("the rectified frame of a near, tilted verged pair has no vertical disparity",
+          "[fovea][tessellation][fixation_frame]") {
+  // A near fixation, tilted: the verged pair's vertical disparity reaches
+  // several pixels towards the corners.
+  const Eigen::Vector3d fixation = AtElevation(0.6, 12);
+  const rig::StereoFrame verged = VergedFrame(fixation, 0.06);
+  const fovea::FixationFrame f = fovea::ToFixationFrame(verged);
+  const fovea::FixationFrame r = fovea::ToRectifiedFrame(verged);
+  REQUIRE(r.resampled);
+  // Centres stay; both views share one orientation and one camera matrix.
+  for (auto [a, o] : {std::pair(&r.views.left, &verged.left), {&r.views.right, &verged.right}})
+    CHECK((a->world_T_camera.translation() - o->world_T_camera.translation()).norm() < 1e-12);
+  CHECK(
+      r.views.left.world_T_camera.linear().isApprox(r.views.right.world_T_camera.linear(), 1e-12));
+  CHECK(r.views.left.intrinsics.cx_px == r.views.right.intrinsics.cx_px);
+  // The left optical axis keeps its pixel.
+  const auto& k = verged.left.intrinsics;
+  const cv::Point2d centre = fovea::MapPixels(r.left_H, {{k.cx_px, k.cy_px}})[0];
+  CHECK(centre.x == Approx(k.cx_px).margin(1e-6));
+  CHECK(centre.y == Approx(k.cy_px).margin(1e-6));
+  CHECK(cv::countNonZero(r.left_valid) > 0.97 * r.left_valid.total());
+  // Points near the image's corners at depths from 0.4 to 1.6 m: the same
+  // row in both rectified views, where the fixation frame's rows differ by
+  // pixels; H maps the original pixels to the rectified ones.
+  double worst_fixation_frame = 0;
+  const Eigen::Isometry3d& left_W = verged.left.world_T_camera;
+  for (const double z : {0.4, 0.6, 1.0, 1.6})
+    for (const double u : {30.0, 320.0, 610.0})
+      for (const double v : {30.0, 450.0}) {
+        const Eigen::Vector3d p = left_W * (z * k.Ray({u, v}));
+        for (const fovea::FixationFrame* frame : {&f, &r}) {
+          const auto l = fovea::ProjectWorldPoint(frame->views.left.world_T_camera,
+                                                  frame->views.left.intrinsics, p);
+          const auto rr = fovea::ProjectWorldPoint(frame->views.right.world_T_camera,
+                                                   frame->views.right.intrinsics, p);
+          REQUIRE((l && rr));
+          if (frame == &r)
+            CHECK(l->y() == Approx(rr->y()).margin(1e-6));
+          else
+            worst_fixation_frame = std::max(worst_fixation_frame, std::abs(l->y() - rr->y()));
+        }
+        const auto o =
+            fovea::ProjectWorldPoint(verged.right.world_T_camera, verged.right.intrinsics, p);
+        const auto rr =
+            fovea::ProjectWorldPoint(r.views.right.world_T_camera, r.views.right.intrinsics, p);
+        REQUIRE((o && rr));
+        const cv::Point2d mapped = fovea::MapPixels(r.right_H, {{o->x(), o->y()}})[0];
+        CHECK(mapped.x == Approx(rr->x()).margin(1e-6));
+        CHECK(mapped.y == Approx(rr->y()).margin(1e-6));
+      }
+  INFO("fixation frame's largest vertical disparity: " << worst_fixation_frame << " px");
+  CHECK(worst_fixation_frame > 2);
+}
+
 TEST_CASE("a level verged pair is its own fixation frame",
           "[fovea][tessellation][fixation_frame]") {
   // The optical centres sit 1 cm above the tilt axes: a point at that height

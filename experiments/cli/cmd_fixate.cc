@@ -81,9 +81,14 @@ void WritePictures(const fovea::FixationResult& r, const sim::GroundTruth& truth
       SideBySide(
           DrawLevels(r.servo.frame.left, t, matched.left_H, cv::Mat(), "left, original"),
           DrawLevels(r.servo.frame.right, t, matched.right_H, cv::Mat(), "right, original")));
-  // Per-level disparity, colour-mapped, upsampled to full size.
-  for (size_t k = 0; k < r.foveal.disparity_px.size(); ++k) {
-    const cv::Mat& d = r.foveal.disparity_px[k];
+  // Per-level disparity, colour-mapped, upsampled to full size (and the
+  // outermost level's in the rectified pair, foveal.rectified_periphery).
+  std::vector<std::pair<std::string, cv::Mat>> disparities;
+  for (size_t k = 0; k < r.foveal.disparity_px.size(); ++k)
+    disparities.emplace_back("disparity_level" + std::to_string(k), r.foveal.disparity_px[k]);
+  if (!r.foveal.rectified_periphery_px.empty())
+    disparities.emplace_back("disparity_rectified_periphery", r.foveal.rectified_periphery_px);
+  for (const auto& [name, d] : disparities) {
     const cv::Mat valid = d == d;  // not NaN
     double lo = 0, hi = 0;
     if (cv::countNonZero(valid)) cv::minMaxLoc(d, &lo, &hi, nullptr, nullptr, valid);
@@ -93,7 +98,7 @@ void WritePictures(const fovea::FixationResult& r, const sim::GroundTruth& truth
     cv::applyColorMap(scaled, colour, cv::COLORMAP_TURBO);
     colour.setTo(cv::Scalar(0, 0, 0), ~valid);
     cv::resize(colour, colour, left.gray.size(), 0, 0, cv::INTER_NEAREST);
-    WriteImageAtomic(dir + "/disparity_level" + std::to_string(k) + ".png", colour);
+    WriteImageAtomic(dir + "/" + name + ".png", colour);
   }
   // This fixation's patches beside the true depth, from the left camera.
   WriteImageAtomic(dir + "/patch_depth_vs_true.png",

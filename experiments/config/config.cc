@@ -288,6 +288,7 @@ void AddFovealParams(RunConfig* c, std::vector<ConfigParam>* params) {
                      {&fp::kFovealClipToInliers, &x.foveal.blocks.clip_to_inliers},
                      {&fp::kFovealClipDiagonals, &x.foveal.blocks.clip_diagonals},
                      {&fp::kFovealRectify, &x.foveal.rectify},
+                     {&fp::kFovealRectifiedPeriphery, &x.foveal.rectified_periphery},
                      {&fp::kFovealSkipFovealEdgePx, &x.foveal.skip_foveal_edge_px},
                      {&fp::kFovealMaxViewAngleDeg, &x.foveal.max_view_angle_deg},
                      {&fp::kFovealFitMinSupport, &x.foveal.plane_fit.min_support},
@@ -302,6 +303,7 @@ void AddFovealParams(RunConfig* c, std::vector<ConfigParam>* params) {
                      {&fp::kFovealServoUniqueRatio, &x.servo.unique_ratio},
                      {&fp::kFovealServoMutualPx, &x.servo.mutual_tolerance_px},
                      {&fp::kFovealSilentConfidence, &x.foveal.silent_confidence},
+                     {&fp::kFovealRectifiedSilentConfidence, &x.foveal.rectified_silent_confidence},
                      {&fp::kFovealSilentCheckLevel, &x.foveal.silent_check_level},
                      {&fp::kFovealServoMaxSteps, &x.servo.max_steps},
                  });

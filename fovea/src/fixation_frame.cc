@@ -80,11 +80,21 @@ rig::CameraView TurnView(const rig::CameraView& view, const Eigen::Matrix3d& rol
   return out;
 }
 
+// CV_8U, 255 where every source pixel of the bilinear sample through `H`
+// (original -> turned) lies inside the original image of `size`.
+cv::Mat ValidAfter(cv::Size size, const cv::Matx33d& H) {
+  const cv::Mat ones(size, CV_8U, cv::Scalar(255));
+  cv::Mat valid;
+  cv::warpPerspective(ones, valid, H, size, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
+  return valid == 255;
+}
+
 }  // namespace
 
 FixationFrame OriginalFrame(const rig::StereoFrame& frame) {
   FixationFrame f;
   f.views = frame;
+  f.original = frame;
   f.left_valid = cv::Mat(frame.left.gray.size(), CV_8U, cv::Scalar(255));
   return f;
 }
@@ -111,15 +121,37 @@ FixationFrame ToFixationFrame(const rig::StereoFrame& frame) {
     return same;
   }
   f.resampled = true;
+  f.original = frame;
   f.views.state = frame.state;
   f.views.timestamp_s = frame.timestamp_s;
   f.views.left = TurnView(frame.left, tl, frame.left.intrinsics, &f.left_H);
   f.views.right = TurnView(frame.right, tr, frame.left.intrinsics, &f.right_H);
-  // Valid where every source pixel of the bilinear sample lies inside.
-  const cv::Mat ones(frame.left.gray.size(), CV_8U, cv::Scalar(255));
-  cv::warpPerspective(ones, f.left_valid, f.left_H, ones.size(), cv::INTER_LINEAR,
-                      cv::BORDER_CONSTANT);
-  f.left_valid = f.left_valid == 255;
+  f.left_valid = ValidAfter(frame.left.gray.size(), f.left_H);
+  return f;
+}
+
+FixationFrame ToRectifiedFrame(const rig::StereoFrame& frame) {
+  const Eigen::Matrix3d& left = frame.left.world_T_camera.linear();
+  const Eigen::Matrix3d& right = frame.right.world_T_camera.linear();
+  Eigen::Matrix3d rect;
+  rect.col(0) = (frame.right.world_T_camera.translation() - frame.left.world_T_camera.translation())
+                    .normalized();
+  const Eigen::Vector3d axis = left.col(2) + right.col(2);
+  rect.col(2) = (axis - rect.col(0).dot(axis) * rect.col(0)).normalized();
+  rect.col(1) = rect.col(2).cross(rect.col(0));
+  // The left optical axis in the new orientation: it keeps its pixel.
+  rig::CameraIntrinsics k = frame.left.intrinsics;
+  const Eigen::Vector3d a = rect.transpose() * left.col(2);
+  k.cx_px -= k.fx_px * a.x() / a.z();
+  k.cy_px -= k.fy_px * a.y() / a.z();
+  FixationFrame f;
+  f.resampled = true;
+  f.original = frame;
+  f.views.state = frame.state;
+  f.views.timestamp_s = frame.timestamp_s;
+  f.views.left = TurnView(frame.left, rect, k, &f.left_H);
+  f.views.right = TurnView(frame.right, rect, k, &f.right_H);
+  f.left_valid = ValidAfter(frame.left.gray.size(), f.left_H);
   return f;
 }
 

@@ -33,6 +33,7 @@ void FovealOptions::Check() const {
   if (!(silent_near_m >= 0)) throw rig::InputError("foveal options: silent_near_m must be >= 0");
   rig::CheckParam(params::kFovealSkipFovealEdgePx, skip_foveal_edge_px);
   rig::CheckParam(params::kFovealMaxViewAngleDeg, max_view_angle_deg);
+  rig::CheckParam(params::kFovealRectifiedSilentConfidence, rectified_silent_confidence);
 }
 
 void FixationOptions::Check() const {
@@ -187,6 +188,23 @@ cv::Mat FovealNearEdges(const PatchMap& map, const cv::Mat& depth, const cv::Mat
 
 namespace {
 
+// The full-resolution pixels a finer level covers, in the frame a level is
+// matched in: the finer level's rectangle, or where the level is matched in
+// another frame (FovealOptions::rectified_periphery) that rectangle mapped
+// into it, a mask.
+struct Inner {
+  cv::Rect rect;
+  cv::Mat mask;  ///< CV_8U, non-zero inside; when not empty, `rect` is unused
+  bool Contains(cv::Point p) const {
+    if (mask.empty()) return rect.contains(p);
+    return p.x >= 0 && p.y >= 0 && p.x < mask.cols && p.y < mask.rows && mask.at<uchar>(p) != 0;
+  }
+};
+
+Inner FinerLevel(const Tessellation& t, int index) {
+  return {index > 0 ? t.rects[index - 1] : cv::Rect(), cv::Mat()};
+}
+
 // Per-pixel disparity ranges of one level (lo > hi: not searched): around the
 // coarser level's estimate, else around the map's prediction, else (the map
 // silent) the Z_T band about the fixation depth, marked in `silent`.
@@ -197,7 +215,7 @@ struct SearchRanges {
 
 SearchRanges LevelRanges(const rig::StereoFrame& frame, const Tessellation& t,
                          const cv::Mat& map_depth, const cv::Mat& skip, const cv::Mat* coarse,
-                         const Level& level, const FovealOptions& options) {
+                         const Level& level, const Inner& inner, const FovealOptions& options) {
   const rig::CameraIntrinsics& k = frame.left.intrinsics;
   const double s = level.scale, z0 = t.fixation_depth_m;
   PixelDisparity disparity(frame, s);
@@ -207,13 +225,12 @@ SearchRanges LevelRanges(const rig::StereoFrame& frame, const Tessellation& t,
                  cv::Mat(size, CV_8U, cv::Scalar(0))};
   // The level's pixels whose centres may fall in its rectangle.
   const cv::Rect inside = LevelPixels(level.rect, s) & cv::Rect(cv::Point(), size);
-  // The finer level's rectangle (its coarse estimates are needed there).
-  const cv::Rect inner = level.index > 0 ? t.rects[level.index - 1] : cv::Rect();
   for (int y = inside.y; y < inside.br().y; ++y)
     for (int x = inside.x; x < inside.br().x; ++x) {
       const auto [u, v, ui, vi] = grid.At(x, y);
       if (!level.rect.contains({ui, vi}) || t.mask.at<uchar>(vi, ui) == 0) continue;
-      if (!skip.empty() && skip.at<uchar>(vi, ui) && !inner.contains({ui, vi})) continue;
+      // (The finer level's coarse estimates are needed inside it.)
+      if (!skip.empty() && skip.at<uchar>(vi, ui) && !inner.Contains({ui, vi})) continue;
       double dlo, dhi;
       const float cd = coarse ? coarse->at<float>(std::min(coarse->rows - 1, y / 2),
                                                   std::min(coarse->cols - 1, x / 2))
@@ -254,8 +271,8 @@ struct SilentCheck {
 };
 
 SilentCheck CheckSilent(const rig::StereoFrame& frame, const Tessellation& t,
-                        const cv::Mat& map_depth, const StereoMatcher& matcher,
-                        const FovealOptions& options) {
+                        const cv::Mat& map_depth, const cv::Rect& region,
+                        const StereoMatcher& matcher, const FovealOptions& options) {
   SilentCheck c;
   c.scale = std::pow(2.0, options.silent_check_level);
   const Level level = MakeLevel(frame, t, 0, options.silent_check_level);
@@ -265,11 +282,10 @@ SilentCheck CheckSilent(const rig::StereoFrame& frame, const Tessellation& t,
   const cv::Size size = level.left.size();
   const LevelGrid grid(size, s, k);
   cv::Mat lo(size, CV_32F, cv::Scalar(1)), hi(size, CV_32F, cv::Scalar(0));
-  const cv::Rect& outer = t.rects.back();
   for (int y = 0; y < size.height; ++y)
     for (int x = 0; x < size.width; ++x) {
       const auto [u, v, ui, vi] = grid.At(x, y);
-      if (!outer.contains({ui, vi}) || t.mask.at<uchar>(vi, ui) == 0 ||
+      if (!region.contains({ui, vi}) || t.mask.at<uchar>(vi, ui) == 0 ||
           map_depth.at<float>(vi, ui) > 0)
         continue;
       disparity.At(u, grid.Ray(x, y));
@@ -432,7 +448,7 @@ std::optional<Patch> BlockPatch(const rig::StereoFrame& frame, const Level& leve
 // level's pixels; their fit tolerance shrinks with the level so that it stays
 // near a full-resolution pixel and a plane cannot bridge a depth step.
 // Returns how many were added.
-int LevelPatches(const rig::StereoFrame& frame, const Tessellation& t, const Level& level,
+int LevelPatches(const rig::StereoFrame& frame, const Level& level, const Inner& inner,
                  const cv::Mat& disparity, const FovealOptions& options, int fixation,
                  PatchMap* patches) {
   const int size = level.index == 0 ? options.fovea_patch_px
@@ -440,11 +456,10 @@ int LevelPatches(const rig::StereoFrame& frame, const Tessellation& t, const Lev
   PlaneFitOptions fit_options = options.plane_fit;
   if (level.index > 0)
     fit_options.fit_tolerance_px = std::max(0.25, options.plane_fit.fit_tolerance_px / level.scale);
-  const cv::Rect inner = level.index > 0 ? t.rects[level.index - 1] : cv::Rect();
   auto in_level = [&](int bx, int by, int block) {
     const cv::Point centre(static_cast<int>((bx + 0.5 * block) * level.scale - 0.5),
                            static_cast<int>((by + 0.5 * block) * level.scale - 0.5));
-    return level.rect.contains(centre) && !(level.index > 0 && inner.contains(centre));
+    return level.rect.contains(centre) && !(level.index > 0 && inner.Contains(centre));
   };
   BlockOptions blocks = options.blocks;
   if (level.index > 0) {
@@ -462,6 +477,66 @@ int LevelPatches(const rig::StereoFrame& frame, const Tessellation& t, const Lev
       ++added;
     }
   return added;
+}
+
+// The pixels of level `index` (the outermost, index > 0) beyond the finer
+// level's rectangle, matched in the pair turned into a rectified one
+// (FovealOptions::rectified_periphery): the map rendered into its left view
+// sets the search ranges and the Z_T mask as in the fixation frame, and the
+// finer level's rectangle, mapped into it, is left to the finer levels.
+// Adds the level's patches to `result` and its counts to `fig`.
+void MatchRectifiedPeriphery(const FixationFrame& matched, const Eigen::Vector3d& fixation_W,
+                             const Tessellation& t, int index, const PatchMap& map,
+                             const StereoMatcher& matcher, const FovealOptions& options,
+                             int fixation, FovealResult* result, LevelFigures* fig) {
+  const FixationFrame rectified = ToRectifiedFrame(matched.original);
+  const rig::StereoFrame& frame = rectified.views;
+  const rig::CameraIntrinsics& k = frame.left.intrinsics;
+  const cv::Rect image(0, 0, k.width_px, k.height_px);
+  cv::Mat depth, ids;
+  map.Render(frame.left.world_T_camera, k, &depth, &ids);
+  Tessellation tr;
+  tr.fixation_depth_m = (frame.left.world_T_camera.inverse() * fixation_W).z();
+  tr.z_t_near_m = t.z_t_near_m;
+  tr.z_t_far_m = t.z_t_far_m;
+  tr.rects.assign(index + 1, image);
+  // Z_T's mask, as TessellateFromDepth's, and pixels turned in from outside.
+  tr.mask = rectified.left_valid.clone();
+  for (int v = 0; v < depth.rows; ++v)
+    for (int u = 0; u < depth.cols; ++u) {
+      const float z = depth.at<float>(v, u);
+      if (z > 0 &&
+          (z - tr.fixation_depth_m > t.z_t_far_m || tr.fixation_depth_m - z > t.z_t_near_m))
+        tr.mask.at<uchar>(v, u) = 0;
+    }
+  // The finer level's rectangle: fixation-frame pixel -> original -> rectified.
+  Inner inner;
+  cv::Mat finer(t.mask.size(), CV_8U, cv::Scalar(0));
+  finer(t.rects[index - 1]).setTo(255);
+  cv::warpPerspective(finer, inner.mask, rectified.left_H * matched.left_H.inv(), image.size(),
+                      cv::INTER_NEAREST, cv::BORDER_CONSTANT);
+  const cv::Mat skip = FovealNearEdges(map, depth, ids, options.skip_foveal_edge_px);
+  SilentCheck silent;
+  if (options.silent_near_m > 0) {
+    const auto t0 = Clock::now();
+    silent = CheckSilent(frame, tr, depth, image, matcher, options);
+    result->silent_check_time_s += Since(t0);
+  }
+  const Level level = MakeLevel(frame, tr, index);
+  const SearchRanges ranges = LevelRanges(frame, tr, depth, skip, nullptr, level, inner, options);
+  DisparityMap dm = matcher.Match(level.left, level.right, ranges.lo, ranges.hi);
+  FovealOptions drop = options;
+  drop.silent_confidence = options.rectified_silent_confidence;
+  const int outside_band =
+      silent.wide.empty() ? 0 : DropOutsideBand(silent, level, ranges, drop, &dm);
+  fig->searched += dm.searched;
+  fig->matched += dm.matched - outside_band;
+  fig->outside_band += outside_band;
+  fig->eroded +=
+      ErodeAtDisparityJumps(options.edge_erosion_px, options.edge_jump_px, &dm.disparity_px);
+  fig->patches +=
+      LevelPatches(frame, level, inner, dm.disparity_px, options, fixation, &result->patches);
+  result->rectified_periphery_px = dm.disparity_px;
 }
 
 }  // namespace
@@ -497,10 +572,26 @@ FovealResult FovealStereo(const FixationFrame& matched, const Eigen::Vector3d& f
   // Pixels turned in from outside the original image are not matched.
   if (result.frame.resampled) t.mask &= result.frame.left_valid;
   const int levels = static_cast<int>(t.rects.size());
+  // With rectified_periphery the outermost level is matched here only about
+  // the finer level (its coarse estimates), and beyond it in the rectified
+  // pair (MatchRectifiedPeriphery).
+  const rig::StereoFrame& original = result.frame.original;
+  const bool rectified_periphery =
+      options.rectified_periphery && levels > 1 && !original.left.gray.empty() &&
+      (original.right.world_T_camera.translation() - original.left.world_T_camera.translation())
+              .norm() > 1e-6;
+  auto matched_here = [&](int index) {
+    if (!rectified_periphery || index + 1 < levels) return t.rects[index];
+    const int margin = 2 << index;  // two of the level's pixels
+    const cv::Rect& finer = t.rects[index - 1];
+    return cv::Rect(finer.x - margin, finer.y - margin, finer.width + 2 * margin,
+                    finer.height + 2 * margin) &
+           t.rects[index];
+  };
   SilentCheck silent;
   if (options.silent_near_m > 0 && levels > 0) {
     const auto t0 = Clock::now();
-    silent = CheckSilent(frame, t, map_depth, matcher, options);
+    silent = CheckSilent(frame, t, map_depth, matched_here(levels - 1), matcher, options);
     result.silent_check_time_s = Since(t0);
   }
   result.disparity_px.resize(levels);
@@ -508,25 +599,31 @@ FovealResult FovealStereo(const FixationFrame& matched, const Eigen::Vector3d& f
   // Coarse to fine: each level's search starts from the coarser one's estimate.
   for (int index = levels - 1; index >= 0; --index) {
     const auto t0 = Clock::now();
-    const Level level = MakeLevel(frame, t, index);
+    Level level = MakeLevel(frame, t, index);
+    level.rect = matched_here(index);
     const cv::Mat* coarse = index + 1 < levels ? &result.disparity_px[index + 1] : nullptr;
-    SearchRanges ranges =
-        LevelRanges(frame, t, map_depth, index > 0 ? skip : cv::Mat(), coarse, level, options);
+    const Inner inner = FinerLevel(t, index);
+    SearchRanges ranges = LevelRanges(frame, t, map_depth, index > 0 ? skip : cv::Mat(), coarse,
+                                      level, inner, options);
     DisparityMap dm = matcher.Match(level.left, level.right, ranges.lo, ranges.hi);
     const int outside_band =
         silent.wide.empty() ? 0 : DropOutsideBand(silent, level, ranges, options, &dm);
 
     LevelFigures& fig = result.levels[index];
     fig.level = index;
-    fig.rect = level.rect;
+    fig.rect = t.rects[index];
     fig.searched = dm.searched;
     fig.matched = dm.matched - outside_band;
     fig.outside_band = outside_band;
-    fig.match_time_s = Since(t0);
     fig.eroded =
         ErodeAtDisparityJumps(options.edge_erosion_px, options.edge_jump_px, &dm.disparity_px);
-    fig.patches =
-        LevelPatches(frame, t, level, dm.disparity_px, options, fixation, &result.patches);
+    if (rectified_periphery && index + 1 == levels)
+      MatchRectifiedPeriphery(result.frame, fixation_W, t, index, map, matcher, options, fixation,
+                              &result, &fig);
+    else
+      fig.patches =
+          LevelPatches(frame, level, inner, dm.disparity_px, options, fixation, &result.patches);
+    fig.match_time_s = Since(t0);
     result.disparity_px[index] = dm.disparity_px;
   }
   result.compute_time_s = Since(t_start);

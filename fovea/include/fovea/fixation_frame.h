@@ -41,6 +41,9 @@ struct FixationFrame {
   /// false: the turns move no pixel by a hundredth of a pixel and views is
   /// the original frame, images not resampled.
   bool resampled = false;
+  /// The pair as captured (its images shared, not copied); empty when the
+  /// frame was put together by hand: then `views` stands for it.
+  rig::StereoFrame original;
 };
 
 /// The fixation frame of a verged `frame`. Where the turns move no pixel by
@@ -51,6 +54,19 @@ FixationFrame ToFixationFrame(const rig::StereoFrame& frame);
 /// The original frame as the frame matched in (the paper's unrectified
 /// matching).
 FixationFrame OriginalFrame(const rig::StereoFrame& frame);
+
+/// A verged `frame` turned in software into an exactly parallel, rectified
+/// pair (beyond the paper; FovealOptions::rectified_periphery): both views
+/// given one orientation, its x axis along the optical centres' offset and
+/// its z axis the mean of the two optical axes made perpendicular to it,
+/// and one camera matrix, the left one's with its principal point moved so
+/// that the left optical axis keeps its pixel (the left image barely moves;
+/// the right one shifts by the vergence). Vertical disparity is then zero at
+/// every pixel and depth, where the verged pair's grows towards the image's
+/// corners (to several pixels at a near fixation). `left_H`, `right_H` map
+/// the original pixels; the rolls and the turn are 0; always resampled.
+/// The optical centres must differ.
+FixationFrame ToRectifiedFrame(const rig::StereoFrame& frame);
 
 /// A pair taken with both cameras pointed straight ahead (IDR's), turned in
 /// software into an exactly parallel, rectified one: both views given the

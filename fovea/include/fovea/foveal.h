@@ -99,6 +99,23 @@ struct FovealOptions {
   /// surface's grazing limb the plane lands 1-5% too far. 0: any angle, the
   /// paper's rule (README, "The map's trust").
   double max_view_angle_deg = 70;
+  /// Beyond the paper (issue 19): the outermost level, where it reaches
+  /// beyond the finer level's rectangle, is matched in the pair turned into
+  /// a rectified one (ToRectifiedFrame), where vertical disparity is zero at
+  /// every pixel; in the verged pair it passes half a level pixel outside
+  /// the rectangle the paper's tessellation gives that level and grows to
+  /// several towards the corners at a near fixation, and the row-wise
+  /// matchers miss there. The fixation frame still matches it about the
+  /// finer level, for that level's coarse estimates. false: the verged
+  /// pair's rows everywhere, the paper's scheme.
+  bool rectified_periphery = true;
+  /// silent_confidence for the rectified periphery: there a band match at a
+  /// pixel the map is silent at is dropped where the wide search matched
+  /// outside the band with at least this confidence. 0 (any match outside
+  /// drops it): matching far more of the periphery than the verged rows,
+  /// the rectified pair also found more of a repeated texture's copies in
+  /// the band (README, "The map's trust").
+  double rectified_silent_confidence = 0;
   void Check() const;  ///< throws rig::InputError naming the key (fovea/params.h)
 };
 
@@ -129,6 +146,11 @@ struct FovealResult {
   FixationFrame frame;
   Tessellation tessellation;
   std::vector<cv::Mat> disparity_px;  ///< per level, at its resolution (NaN = none)
+  /// With FovealOptions::rectified_periphery, the outermost level's
+  /// disparities in the rectified pair (ToRectifiedFrame; its level's
+  /// resolution, NaN = none); disparity_px then holds that level only about
+  /// the finer one. Empty otherwise.
+  cv::Mat rectified_periphery_px;
   std::vector<LevelFigures> levels;
   PatchMap patches;  ///< foveal (level 0) and peripheral patches
   double compute_time_s = 0;

@@ -218,6 +218,17 @@ inline constexpr ParamSpec kFovealRectify{
     "beyond the paper: servo, tessellate and match in the pair's fixation frame (both images "
     "turned so that a tilted verged pair's rows do not twist and the optical axes meet; false = "
     "the paper's unrectified images)"};
+inline constexpr ParamSpec kFovealRectifiedPeriphery{
+    "foveal.rectified_periphery",
+    "beyond the paper: the outermost level, beyond the finer level's rectangle, is matched in the "
+    "pair turned into a rectified one, where vertical disparity is zero everywhere (false = the "
+    "verged pair's rows, the paper's scheme)"};
+inline constexpr ParamSpec kFovealRectifiedSilentConfidence{
+    "foveal.rectified_silent_confidence",
+    "foveal.silent_confidence for the rectified periphery (foveal.rectified_periphery): a band "
+    "match where the map is silent is dropped where the wide search matched outside the band "
+    "with at least this confidence",
+    0, 1};
 inline constexpr ParamSpec kFovealSkipFovealEdgePx{
     "foveal.skip_foveal_edge_px",
     "beyond the paper: the peripheral levels do not match pixels outside the finer level's "
