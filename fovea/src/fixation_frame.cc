@@ -149,8 +149,13 @@ FixationFrame ToRectifiedFrame(const rig::StereoFrame& frame) {
   f.original = frame;
   f.views.state = frame.state;
   f.views.timestamp_s = frame.timestamp_s;
-  f.views.left = TurnView(frame.left, rect, k, &f.left_H);
-  f.views.right = TurnView(frame.right, rect, k, &f.right_H);
+  // Grey only: the rectified pair is matched, never shown.
+  auto grey = [](rig::CameraView view) {
+    view.bgr = cv::Mat();
+    return view;
+  };
+  f.views.left = TurnView(grey(frame.left), rect, k, &f.left_H);
+  f.views.right = TurnView(grey(frame.right), rect, k, &f.right_H);
   f.left_valid = ValidAfter(frame.left.gray.size(), f.left_H);
   return f;
 }

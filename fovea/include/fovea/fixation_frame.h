@@ -64,8 +64,8 @@ FixationFrame OriginalFrame(const rig::StereoFrame& frame);
 /// the right one shifts by the vergence). Vertical disparity is then zero at
 /// every pixel and depth, where the verged pair's grows towards the image's
 /// corners (to several pixels at a near fixation). `left_H`, `right_H` map
-/// the original pixels; the rolls and the turn are 0; always resampled.
-/// The optical centres must differ.
+/// the original pixels; the rolls and the turn are 0; always resampled,
+/// grey images only. The optical centres must differ.
 FixationFrame ToRectifiedFrame(const rig::StereoFrame& frame);
 
 /// A pair taken with both cameras pointed straight ahead (IDR's), turned in
