@@ -289,6 +289,8 @@ void AddFovealParams(RunConfig* c, std::vector<ConfigParam>* params) {
                      {&fp::kFovealClipDiagonals, &x.foveal.blocks.clip_diagonals},
                      {&fp::kFovealRectify, &x.foveal.rectify},
                      {&fp::kFovealRectifiedPeriphery, &x.foveal.rectified_periphery},
+                     {&fp::kFovealRectifiedPeripheryFullResolution,
+                      &x.foveal.rectified_periphery_full_resolution},
                      {&fp::kFovealSkipFovealEdgePx, &x.foveal.skip_foveal_edge_px},
                      {&fp::kFovealMaxViewAngleDeg, &x.foveal.max_view_angle_deg},
                      {&fp::kFovealFitMinSupport, &x.foveal.plane_fit.min_support},

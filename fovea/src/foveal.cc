@@ -522,7 +522,8 @@ void MatchRectifiedPeriphery(const FixationFrame& matched, const Eigen::Vector3d
     silent = CheckSilent(frame, tr, depth, image, matcher, options);
     result->silent_check_time_s += Since(t0);
   }
-  const Level level = MakeLevel(frame, tr, index);
+  const Level level =
+      MakeLevel(frame, tr, index, options.rectified_periphery_full_resolution ? 0 : index);
   const SearchRanges ranges = LevelRanges(frame, tr, depth, skip, nullptr, level, inner, options);
   DisparityMap dm = matcher.Match(level.left, level.right, ranges.lo, ranges.hi);
   FovealOptions drop = options;

@@ -229,6 +229,10 @@ inline constexpr ParamSpec kFovealRectifiedSilentConfidence{
     "match where the map is silent is dropped where the wide search matched outside the band "
     "with at least this confidence",
     0, 1};
+inline constexpr ParamSpec kFovealRectifiedPeripheryFullResolution{
+    "foveal.rectified_periphery_full_resolution",
+    "with foveal.rectified_periphery: the rectified periphery is matched at full resolution, in "
+    "blocks of the level's size in level pixels (false = at its level's resolution)"};
 inline constexpr ParamSpec kFovealSkipFovealEdgePx{
     "foveal.skip_foveal_edge_px",
     "beyond the paper: the peripheral levels do not match pixels outside the finer level's "
