@@ -505,9 +505,7 @@ void MatchRectifiedPeriphery(const FixationFrame& matched, const Eigen::Vector3d
   for (int v = 0; v < depth.rows; ++v)
     for (int u = 0; u < depth.cols; ++u) {
       const float z = depth.at<float>(v, u);
-      if (z > 0 &&
-          (z - tr.fixation_depth_m > t.z_t_far_m || tr.fixation_depth_m - z > t.z_t_near_m))
-        tr.mask.at<uchar>(v, u) = 0;
+      if (z > 0 && tr.BeyondZt(z)) tr.mask.at<uchar>(v, u) = 0;
     }
   // The finer level's rectangle: fixation-frame pixel -> original -> rectified.
   Inner inner;

@@ -138,11 +138,11 @@ Tessellation TessellateFromDepth(const rig::CameraView& left, const rig::CameraV
     for (int u = 0; u < k.width_px; ++u) {
       const float z = depth.at<float>(v, u);
       if (z <= 0) continue;
-      const double off = z - z0;
-      if (off > t.z_t_far_m || -off > t.z_t_near_m) {
+      if (t.BeyondZt(z)) {
         t.mask.at<uchar>(v, u) = 0;
         continue;
       }
+      const double off = z - z0;
       t.z_max_far_m = std::max(t.z_max_far_m, off);
       t.z_max_near_m = std::max(t.z_max_near_m, -off);
     }

@@ -232,7 +232,8 @@ inline constexpr ParamSpec kFovealRectifiedSilentConfidence{
 inline constexpr ParamSpec kFovealRectifiedPeripheryFullResolution{
     "foveal.rectified_periphery_full_resolution",
     "with foveal.rectified_periphery: the rectified periphery is matched at full resolution, in "
-    "blocks of the level's size in level pixels (false = at its level's resolution)"};
+    "blocks of the level's size in level pixels (false = at its level's resolution: about half "
+    "the compute per fixation, more wrong pixels beside depth edges)"};
 inline constexpr ParamSpec kFovealSkipFovealEdgePx{
     "foveal.skip_foveal_edge_px",
     "beyond the paper: the peripheral levels do not match pixels outside the finer level's "

@@ -43,6 +43,12 @@ struct Tessellation {
 
   /// The finest level whose rectangle contains the pixel.
   int LevelAt(int u, int v) const;
+  /// Whether a surface at planar depth `z_m` lies beyond Z_T of the
+  /// fixation (`mask`'s rule where the map shows one).
+  bool BeyondZt(double z_m) const {
+    const double off = z_m - fixation_depth_m;
+    return off > z_t_far_m || -off > z_t_near_m;
+  }
 };
 
 /// Horizontal disparity (u_right - cx_right) of the point on the left
