@@ -19,6 +19,7 @@
 #include "fovea/ddr.h"
 #include "fovea/sgbm.h"
 #include "fovea/timing.h"
+#include "fovea/visibility.h"
 #include "hardware_setup.h"
 #include "scene_options.h"
 #include "scenes/catalog.h"
@@ -172,6 +173,7 @@ nlohmann::json FoveaSummary(const fovea::FoveaRun& run, const MapScore& score,
       {"stages", run.idr.stages.size()},
       {"final_baseline_m", run.idr.stages.empty() ? 0.0 : run.idr.stages.back().baseline_m},
       {"patches", run.idr.map.size()},
+      {"hidden_in_reference", run.idr_hidden},
       {"stop_reason", run.idr.stop_reason}};
   double pan = 0, tilt = 0, carriage = 0, loop_motion = 0;
   for (const auto& r : run.records)
@@ -221,18 +223,22 @@ int Run(const RunArgs& args) {
   rf::Recorder recorder(dir, sim->scene_path(), ref, sim->truth(), config);
   fovea::FoveaOptions options = config.fovea;
   options.seed = config.seed;
-  const fovea::FoveaRun run = fovea::RunFovea(
-      rig, *fovea::MakeMatcher(config.matcher, config.fovea), options, std::ref(recorder));
+  const fovea::FoveaRun run =
+      fovea::RunFovea(rig, *fovea::MakeMatcher(config.matcher, config.fovea), options,
+                      std::ref(recorder), &ref.view);
   recorder.Finish();
   t = Clock::now();
+  // What the map shows in the reference view: the patches the reference
+  // camera sees (the map keeps the others).
+  const fovea::PatchMap seen = fovea::ReferenceMap(run.map);
   const MapScore score =
-      ScoreMap(run.map, ref, sim->truth(), config.fovea.fixation.baseline_m, /*per_patch=*/true);
+      ScoreMap(seen, ref, sim->truth(), config.fovea.fixation.baseline_m, /*per_patch=*/true);
   // Where the fixations started from: the curves of coverage against
   // fixations and motion begin here.
   const MapScore idr_score =
       ScoreMap(run.idr.map, ref, sim->truth(), config.fovea.fixation.baseline_m, false);
   const nlohmann::json vs_static =
-      config.compare_static ? VsStatic(rig, config, run.map, ref) : nlohmann::json();
+      config.compare_static ? VsStatic(rig, config, seen, ref) : nlohmann::json();
   recorder.scoring_s += Since(t);
   t = Clock::now();
   WriteTextAtomic(dir + "/" + rf::kRecords, recorder.records());
@@ -240,7 +246,7 @@ int Run(const RunArgs& args) {
   WriteImageAtomic(dir + "/" + rf::kFixationPath,
                    FixationPath(ref, recorder.path(), recorder.refused()));
   WriteImageAtomic(dir + "/" + rf::kReference, ref.view.gray);
-  WriteImageAtomic(dir + "/" + rf::kErrorPicture, ErrorPicture(run.map, ref));
+  WriteImageAtomic(dir + "/" + rf::kErrorPicture, ErrorPicture(seen, ref));
   recorder.output_s += Since(t);
   const double wall = Since(t_wall);
   nlohmann::json summary =

@@ -357,6 +357,7 @@ void AddDdrParams(RunConfig* c, std::vector<ConfigParam>* params) {
           {&fp::kIntegrationRetireIdr, &f.integration.retire_idr},
           {&fp::kIntegrationRetireIdrShare, &f.integration.retire_idr_share},
           {&fp::kIntegrationRetireInFixationView, &f.integration.retire_in_fixation_view},
+          {&fp::kIntegrationReferenceMinNcc, &f.integration.reference_min_ncc},
       });
 }
 

@@ -10,6 +10,7 @@
 #include "experiments/scoring/foveal_eval.h"
 #include "fovea/stats.h"
 #include "fovea/timing.h"
+#include "fovea/visibility.h"
 
 namespace experiments::run_folder {
 namespace {
@@ -64,6 +65,7 @@ void AddFixation(const fovea::FixationRecord& r, nlohmann::json* j) {
                          {"dropped_contradicted", in.dropped_contradicted},
                          {"fused", in.fused},
                          {"retired_idr", in.retired_idr},
+                         {"hidden_in_reference", in.hidden_in_reference},
                          {"removed_contradicted_idr", in.removed_contradicted[0]},
                          {"removed_contradicted_peripheral", in.removed_contradicted[1]},
                          {"removed_contradicted_foveal", in.removed_contradicted[2]}};
@@ -191,7 +193,7 @@ void Recorder::operator()(const fovea::FixationRecord& r, const fovea::PatchMap&
   Pending p;
   p.record = r;
   if (r.ok) p.surface = SurfaceAt(r.fixation_W);
-  p.map = std::make_shared<const fovea::PatchMap>(map);
+  p.map = std::make_shared<const fovea::PatchMap>(fovea::ReferenceMap(map));
   p.score = std::async(std::launch::async, [this, m = p.map] {
     return ScoreMap(*m, ref_, truth_, baseline_m_, false);
   });

@@ -9,6 +9,7 @@
 #include "fovea/stats.h"
 #include "fovea/strategy.h"
 #include "fovea/timing.h"
+#include "fovea/visibility.h"
 
 namespace fovea {
 namespace {
@@ -152,11 +153,16 @@ void RecordFixation(const FixationResult& r, FixationRecord* rec) {
 // Merges a fixation's patches into the map (timed as integration) and moves
 // the loop on to the fixation's view.
 void Absorb(const FixationResult& r, const rig::CameraView& idr_view,
-            const IntegrationOptions& integration, int stall_fixations, FoveaRun* run,
-            LoopState* state, FixationRecord* rec) {
+            const rig::CameraView* reference, const IntegrationOptions& integration,
+            int stall_fixations, FoveaRun* run, LoopState* state, FixationRecord* rec) {
   const auto t = Clock::now();
   state->frame = r.servo.frame;
-  rec->integration = Integrate(&run->map, r.foveal.patches, state->frame.left, integration);
+  PatchMap fresh = r.foveal.patches;
+  const int hidden = reference ? MarkHiddenFromReference(&fresh, state->frame.left, *reference,
+                                                         {integration.reference_min_ncc})
+                               : 0;
+  rec->integration = Integrate(&run->map, fresh, state->frame.left, integration);
+  rec->integration.hidden_in_reference = hidden;
   if (integration.retire_idr) {
     // Covered in the IDR view or in this fixation's: the views differ in
     // where they stand and what they see past the nearer surfaces.
@@ -201,7 +207,7 @@ DepthRange HoleDepths(const PatchMap& idr_map, const rig::CameraView& idr_view,
 }
 
 FoveaRun RunFovea(rig::Rig& rig, const StereoMatcher& matcher, const FoveaOptions& options,
-                  const FixationObserver& observer) {
+                  const FixationObserver& observer, const rig::CameraView* reference_view) {
   options.Check();  // once: nothing below checks again
   FoveaRun run;
   std::mt19937_64 rng(options.seed);
@@ -212,10 +218,27 @@ FoveaRun RunFovea(rig::Rig& rig, const StereoMatcher& matcher, const FoveaOption
   AtResolutionLevel(selection.resolution_level, &selection, &criteria);
   const std::unique_ptr<FixationStrategy> strategy = MakeStrategy(selection, criteria);
   const FixationOptions fixation_options = ResolvedFixationOptions(options);
+  // The reference view the map is read in, the left camera at the home
+  // pose (IntegrationOptions::reference_min_ncc): the caller's, or captured.
+  std::optional<rig::CameraView> reference;
+  if (options.integration.reference_min_ncc > 0) {
+    if (reference_view) {
+      reference = *reference_view;
+    } else {
+      run.motion_time_s += rig.MoveTo(rig.Home()).motion_time_s;
+      reference = rig.Capture().left;
+    }
+  }
   run.idr = RunIdr(rig, options.idr);
   run.map = run.idr.map;
-  run.motion_time_s = run.idr.motion_time_s;
+  run.motion_time_s += run.idr.motion_time_s;
   run.compute_time_s = run.idr.compute_time_s;
+  if (reference) {
+    const auto t = Clock::now();
+    run.idr_hidden = MarkHiddenFromReference(&run.map, run.idr.final_frame.left, *reference,
+                                             {options.integration.reference_min_ncc});
+    run.compute_time_s += Since(t);
+  }
   if (options.selection.first_fixation == "idr" && !run.idr.has_fixation) {
     run.stop_reason = "IDR found no point to fixate";
     return run;
@@ -268,7 +291,8 @@ FoveaRun RunFovea(rig::Rig& rig, const StereoMatcher& matcher, const FoveaOption
     }
     rec.fixation = ++run.fixations_done;
     RecordFixation(r, &rec);
-    Absorb(r, idr_view, options.integration, options.stall_fixations, &run, &state, &rec);
+    Absorb(r, idr_view, reference ? &*reference : nullptr, options.integration,
+           options.stall_fixations, &run, &state, &rec);
     record(rec);
     state.share_history.push_back(rec.foveal_share);
     if (Stalled(state.share_history, options)) {

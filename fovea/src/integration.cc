@@ -14,6 +14,7 @@ void IntegrationOptions::Check() const {
   rig::CheckParam(params::kIntegrationOverlapShare, overlap_share);
   rig::CheckParam(params::kIntegrationRetireIdrShare, retire_idr_share);
   rig::CheckParam(params::kIntegrationContradictionShare, contradiction_share);
+  rig::CheckParam(params::kIntegrationReferenceMinNcc, reference_min_ncc);
 }
 
 namespace {

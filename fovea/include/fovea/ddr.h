@@ -115,6 +115,9 @@ struct FixationRecord {
 struct FoveaRun {
   IdrResult idr;
   PatchMap map;
+  /// IDR patches the reference camera does not see (Patch::
+  /// hidden_in_reference; IntegrationOptions::reference_min_ncc).
+  int idr_hidden = 0;
   std::vector<FixationRecord> records;
   int fixations_done = 0;
   std::string stop_reason;
@@ -132,8 +135,12 @@ DepthRange HoleDepths(const PatchMap& idr_map, const rig::CameraView& idr_view,
 using FixationObserver = std::function<void(const FixationRecord&, const PatchMap&)>;
 
 /// Runs FOVEA on a rig. Throws rig::RigError if the rig fails; points that
-/// cannot be fixated are recorded and skipped.
+/// cannot be fixated are recorded and skipped. `reference_view`, if given,
+/// is the left camera's image at the home pose (IntegrationOptions::
+/// reference_min_ncc); without it, a run with the check on moves home and
+/// captures one first.
 FoveaRun RunFovea(rig::Rig& rig, const StereoMatcher& matcher, const FoveaOptions& options,
-                  const FixationObserver& observer = {});
+                  const FixationObserver& observer = {},
+                  const rig::CameraView* reference_view = nullptr);
 
 }  // namespace fovea

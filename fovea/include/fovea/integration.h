@@ -43,6 +43,11 @@ struct IntegrationOptions {
   /// patch the IDR view sees mostly uncovered can be covered where the
   /// fixation looked.
   bool retire_in_fixation_view = true;
+  /// Beyond the paper: a new patch the reference camera (the left camera at
+  /// the home pose) does not see is marked so (Patch::hidden_in_reference,
+  /// by HiddenQuarters with this as ReferenceCheckOptions::min_ncc; 0:
+  /// none is): kept in the map, left out of its depth in the reference view.
+  double reference_min_ncc = 0.5;
   void Check() const;  ///< throws rig::InputError naming the key (fovea/params.h)
 };
 
@@ -54,6 +59,7 @@ struct IntegrationStats {
   int dropped_contradicted = 0;  ///< new patches dropped: the map contradicts them
   int fused = 0;                 ///< new patches fused with the map's depth
   int retired_idr = 0;           ///< IDR patches finer data covers (retire_idr)
+  int hidden_in_reference = 0;   ///< new patches the reference camera does not see
   std::array<int, 3> replaced{0, 0, 0};              ///< old patches removed, by their PatchLevel
   std::array<int, 3> removed_contradicted{0, 0, 0};  ///< old patches new data contradicts, by level
 };

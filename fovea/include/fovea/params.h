@@ -391,6 +391,14 @@ inline constexpr ParamSpec kIntegrationRetireInFixationView{
     "integration.retire_in_fixation_view",
     "beyond the paper: with integration.retire_idr, IDR patches covered in the fixation's own "
     "view are retired too (false: in the IDR view only)"};
+inline constexpr ParamSpec kIntegrationReferenceMinNcc{
+    "integration.reference_min_ncc",
+    "beyond the paper: a new patch the reference camera (the left camera at the home pose) does "
+    "not see stays in the map but leaves its depth in the reference view: the normalized "
+    "cross-correlation of its texture in the image it was measured in and in the reference image, "
+    "sampled on its plane, is below this in its left or right half or three of its quarters (a "
+    "farther surface seen past a nearer one's edge from another viewpoint; 0 = no check)",
+    0, 1};
 inline constexpr ParamSpec kLoopFixations{"loop.fixations", "successful fixations to make", 1,
                                           10000};
 inline constexpr ParamSpec kLoopStayInIdrView{

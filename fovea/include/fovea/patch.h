@@ -31,6 +31,11 @@ struct Patch {
   /// its centre, metres (DepthSigma): what integration and the map's
   /// rendering weigh observations by. 0: unknown (treated as certain).
   double sigma_z_m = 0;
+  /// The reference camera does not see it (HiddenQuarters): a surface
+  /// seen past a nearer one's edge from another viewpoint. It stays in the
+  /// map (it is there, and other views see it) but not in the map's depth in
+  /// the reference view (ReferenceMap).
+  bool hidden_in_reference = false;
 
   /// Order of precedence between patches of the same surface: foveal over
   /// peripheral over IDR, and within a level the finer resolution first.

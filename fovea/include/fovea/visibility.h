@@ -1,0 +1,64 @@
+// Whether the reference camera sees what a patch measured (beyond the paper).
+//
+// A fixation's cameras stand centimetres away from the reference view's (the
+// left camera at the home pose, where the map is read). Past a nearer
+// surface's edge they see parts of a farther surface that the reference
+// view cannot: those patches are true in 3D, but wherever the nearer
+// surface is not mapped (the strip erosion and the block fits leave along
+// its edge, or a whole surface no fixation has visited yet) they show
+// through in the reference view with the farther depth. Geometry cannot
+// tell them apart while the nearer surface is missing from the map; the
+// reference camera's image can: sampled on the patch's plane, it shows the
+// patch's texture only if it sees the patch.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "fovea/patch.h"
+#include "rig/types.h"
+
+namespace fovea {
+
+struct ReferenceCheckOptions {
+  /// A quarter of a patch is hidden from the reference view when the
+  /// normalized cross-correlation between its texture in the image it was
+  /// measured in and in the reference image (both sampled at the same points
+  /// of its plane) is below this. 0: no check.
+  double min_ncc = 0;
+  /// A quarter whose samples in the measuring image vary less than this
+  /// (standard deviation, grey levels) cannot be judged and passes.
+  double min_texture_dn = 4;
+};
+
+/// Per patch of `patches` (in order), a bit per quarter (bit 2 v + u for
+/// the quarter u, v in {0, 1} across and down its corners' order) set where
+/// the reference camera `reference` does not see that quarter by
+/// ReferenceCheckOptions, its texture sampled on the patch's plane in
+/// `measured` (the image its footprint was matched in) and in `reference`.
+/// A quarter is judged where at least 3/4 of its samples fall inside both
+/// images, else it passes. Samples per patch: its size in `measured` in
+/// pixels, squared (4 to 32 per side). Cost: O(samples).
+std::vector<std::uint8_t> HiddenQuarters(const PatchMap& patches, const rig::CameraView& measured,
+                                         const rig::CameraView& reference,
+                                         const ReferenceCheckOptions& options);
+
+/// Whether the quarters HiddenQuarters marks make a patch hidden: its left
+/// or its right half, or three quarters or more. The cameras move along the
+/// rail, so the reference view loses sight of a surface past a nearer
+/// one's edge across it, beside an edge that runs up and down the image; a
+/// lone quarter, or a top or bottom half, is a texture that decorrelates
+/// (a grazing surface's fine stripes under a slightly wrong plane, noise on
+/// a faint texture) rather than an occluder.
+bool HiddenSide(std::uint8_t quarters);
+
+/// Sets Patch::hidden_in_reference on the patches HiddenSide judges hidden
+/// by HiddenQuarters; returns how many.
+int MarkHiddenFromReference(PatchMap* patches, const rig::CameraView& measured,
+                            const rig::CameraView& reference, const ReferenceCheckOptions& options);
+
+/// The map as the reference view shows it: its patches but those the
+/// reference camera does not see (Patch::hidden_in_reference).
+PatchMap ReferenceMap(const PatchMap& map);
+
+}  // namespace fovea

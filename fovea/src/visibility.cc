@@ -1,0 +1,119 @@
+#include "fovea/visibility.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <optional>
+
+#include "fovea/geometry.h"
+
+namespace fovea {
+namespace {
+
+// Bilinear grey level at (x, y), or nullopt outside the image's pixel
+// centres.
+std::optional<double> SampleGray(const cv::Mat& gray, const Eigen::Vector2d& p) {
+  const double x = p.x(), y = p.y();
+  if (!(x >= 0 && y >= 0 && x <= gray.cols - 1.001 && y <= gray.rows - 1.001)) return std::nullopt;
+  const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
+  const double fx = x - x0, fy = y - y0;
+  const uchar* r0 = gray.ptr<uchar>(y0) + x0;
+  const uchar* r1 = gray.ptr<uchar>(y0 + 1) + x0;
+  return (1 - fy) * ((1 - fx) * r0[0] + fx * r0[1]) + fy * ((1 - fx) * r1[0] + fx * r1[1]);
+}
+
+// Sums for one normalized cross-correlation.
+struct NccSums {
+  int n = 0;
+  double a = 0, b = 0, aa = 0, bb = 0, ab = 0;
+  void Add(double x, double y) {
+    ++n;
+    a += x, b += y, aa += x * x, bb += y * y, ab += x * y;
+  }
+  double VarA() const { return n ? aa / n - (a / n) * (a / n) : 0; }
+  double Ncc() const {
+    const double va = aa - a * a / n, vb = bb - b * b / n, cov = ab - a * b / n;
+    return va > 0 && vb > 0 ? cov / std::sqrt(va * vb) : 0;
+  }
+};
+
+// The point of a patch at (s, t) in [0, 1]^2, bilinear between its corners
+// (top-left, top-right, bottom-right, bottom-left): on its plane.
+Eigen::Vector3d QuadPoint(const Patch& p, double s, double t) {
+  const std::array<Eigen::Vector3d, 4>& c = p.corners_W;
+  return (1 - t) * ((1 - s) * c[0] + s * c[1]) + t * ((1 - s) * c[3] + s * c[2]);
+}
+
+}  // namespace
+
+bool HiddenSide(std::uint8_t quarters) {
+  const int count =
+      ((quarters >> 0) & 1) + ((quarters >> 1) & 1) + ((quarters >> 2) & 1) + ((quarters >> 3) & 1);
+  return (quarters & 5) == 5 || (quarters & 10) == 10 || count >= 3;
+}
+
+std::vector<std::uint8_t> HiddenQuarters(const PatchMap& patches, const rig::CameraView& measured,
+                                         const rig::CameraView& reference,
+                                         const ReferenceCheckOptions& options) {
+  std::vector<std::uint8_t> hidden(patches.size(), 0);
+  if (options.min_ncc <= 0) return hidden;
+  const Eigen::Isometry3d m_T_w = measured.world_T_camera.inverse();
+  const Eigen::Isometry3d r_T_w = reference.world_T_camera.inverse();
+  const double min_var = options.min_texture_dn * options.min_texture_dn;
+  for (size_t i = 0; i < patches.size(); ++i) {
+    const Patch& patch = patches[i];
+    // Samples about a pixel apart in the measuring image.
+    double side_px = 0;
+    for (int k = 0; k < 4; ++k) {
+      const auto a = ProjectIntoCamera(m_T_w, measured.intrinsics, patch.corners_W[k]);
+      const auto b = ProjectIntoCamera(m_T_w, measured.intrinsics, patch.corners_W[(k + 1) % 4]);
+      if (a && b) side_px = std::max(side_px, (*a - *b).norm());
+    }
+    const int n = 2 * std::clamp(static_cast<int>(std::lround(side_px / 2)), 2, 16);
+    std::array<NccSums, 4> quarter;
+    std::array<int, 4> tried{0, 0, 0, 0};
+    for (int v = 0; v < n; ++v)
+      for (int u = 0; u < n; ++u) {
+        const Eigen::Vector3d x = QuadPoint(patch, (u + 0.5) / n, (v + 0.5) / n);
+        const int q = (v >= n / 2) * 2 + (u >= n / 2);
+        ++tried[q];
+        const auto pm = ProjectIntoCamera(m_T_w, measured.intrinsics, x);
+        const auto pr = ProjectIntoCamera(r_T_w, reference.intrinsics, x);
+        if (!pm || !pr) continue;
+        const auto gm = SampleGray(measured.gray, *pm), gr = SampleGray(reference.gray, *pr);
+        if (gm && gr) quarter[q].Add(*gm, *gr);
+      }
+    for (int q = 0; q < 4; ++q) {
+      const NccSums& sums = quarter[q];
+      if (4 * sums.n < 3 * tried[q] || sums.VarA() < min_var) continue;
+      if (sums.Ncc() < options.min_ncc) hidden[i] |= std::uint8_t(1u << q);
+    }
+  }
+  return hidden;
+}
+
+int MarkHiddenFromReference(PatchMap* patches, const rig::CameraView& measured,
+                            const rig::CameraView& reference,
+                            const ReferenceCheckOptions& options) {
+  const std::vector<std::uint8_t> hidden = HiddenQuarters(*patches, measured, reference, options);
+  PatchMap marked;
+  int count = 0;
+  for (size_t i = 0; i < patches->size(); ++i) {
+    Patch p = (*patches)[i];
+    p.hidden_in_reference = HiddenSide(hidden[i]);
+    count += p.hidden_in_reference;
+    marked.Add(p);
+  }
+  *patches = std::move(marked);
+  return count;
+}
+
+PatchMap ReferenceMap(const PatchMap& map) {
+  PatchMap seen;
+  for (const Patch& p : map.patches())
+    if (!p.hidden_in_reference) seen.Add(p);
+  return seen;
+}
+
+}  // namespace fovea

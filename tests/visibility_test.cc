@@ -1,0 +1,131 @@
+// The reference check: a patch is kept only where the reference camera sees
+// its texture (HiddenQuarters, MarkHiddenFromReference, ReferenceMap).
+#include "fovea/visibility.h"
+
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <cstdint>
+
+#include "test_views.h"
+
+namespace {
+
+// A scene of two textured planes facing the cameras (world X right, Y
+// forward, Z up): a near half-plane at Y = 0.6 m where X < 0, its edge at
+// X = 0, before a far plane at Y = 1.3 m. From a camera at X = c the far
+// plane shows for X > -1.1667 c, past the near plane's edge.
+constexpr double kNearY = 0.6, kFarY = 1.3;
+
+// Value noise: a random grey level per cell of `cell_m`, bilinear between
+// cells (splitmix64 of the cell and the seed).
+double Texture(double x, double z, std::uint64_t seed, double cell_m) {
+  auto cell = [seed](std::int64_t i, std::int64_t j) {
+    std::uint64_t h = seed * 0x9e3779b97f4a7c15ull +
+                      static_cast<std::uint64_t>(i) * 0xbf58476d1ce4e5b9ull +
+                      static_cast<std::uint64_t>(j) * 0x94d049bb133111ebull;
+    h = (h ^ (h >> 30)) * 0xbf58476d1ce4e5b9ull;
+    h = (h ^ (h >> 27)) * 0x94d049bb133111ebull;
+    h ^= h >> 31;
+    return double(h % 200) + 28;
+  };
+  const double u = x / cell_m, v = z / cell_m;
+  const auto i = static_cast<std::int64_t>(std::floor(u)),
+             j = static_cast<std::int64_t>(std::floor(v));
+  const double fu = u - i, fv = v - j;
+  return (1 - fv) * ((1 - fu) * cell(i, j) + fu * cell(i + 1, j)) +
+         fv * ((1 - fu) * cell(i, j + 1) + fu * cell(i + 1, j + 1));
+}
+
+// A forward-looking camera at X = x_m, its image of the scene.
+rig::CameraView Camera(double x_m) {
+  rig::CameraView view = ForwardView(320, 240, 600);
+  view.world_T_camera.translation() = Eigen::Vector3d(x_m, 0, 0);
+  const rig::CameraIntrinsics& k = view.intrinsics;
+  view.gray = cv::Mat(k.height_px, k.width_px, CV_8U);
+  for (int v = 0; v < k.height_px; ++v)
+    for (int u = 0; u < k.width_px; ++u) {
+      const Eigen::Vector3d d =
+          view.world_T_camera.linear() *
+          Eigen::Vector3d((u - k.cx_px) / k.fx_px, (v - k.cy_px) / k.fy_px, 1);
+      Eigen::Vector3d p = view.world_T_camera.translation() + d * (kNearY / d.y());
+      const bool near = p.x() < 0;
+      if (!near) p = view.world_T_camera.translation() + d * (kFarY / d.y());
+      view.gray.at<uchar>(v, u) = cv::saturate_cast<uchar>(near ? Texture(p.x(), p.z(), 1, 0.002)
+                                                                : Texture(p.x(), p.z(), 2, 0.004));
+    }
+  return view;
+}
+
+// A 24 mm square patch on the plane at depth y, centred at X = x, Z = 0.
+fovea::Patch Square(double x, double y) {
+  constexpr double h = 0.012;
+  fovea::Patch p;
+  p.corners_W = {Eigen::Vector3d(x - h, y, h), Eigen::Vector3d(x + h, y, h),
+                 Eigen::Vector3d(x + h, y, -h), Eigen::Vector3d(x - h, y, -h)};
+  return p;
+}
+
+}  // namespace
+
+TEST_CASE(
+    "the quarters of patches of a farther surface seen past a nearer one's edge are hidden "
+    "from the reference camera; what it sees is not",
+    "[fovea][visibility]") {
+  // Measured from X = +4 cm; the reference camera stands at X = -1 cm. The
+  // far plane shows for X > -4.7 cm from the first, X > +1.17 cm from the
+  // second.
+  const rig::CameraView measured = Camera(0.04), reference = Camera(-0.01);
+  fovea::PatchMap patches;
+  patches.Add(Square(-0.025, kFarY));  // seen past the edge by the measuring camera only
+  patches.Add(Square(0.012, kFarY));   // its left half behind the near plane from the reference
+  patches.Add(Square(0.05, kFarY));    // the far plane both see
+  patches.Add(Square(-0.05, kNearY));  // the near plane
+  const fovea::ReferenceCheckOptions check{0.5, 4};
+  // Bits 2 v + u: the left quarters are bits 0 and 2.
+  CHECK(fovea::HiddenQuarters(patches, measured, reference, check) ==
+        std::vector<std::uint8_t>{15, 5, 0, 0});
+  // The check off: nothing is hidden.
+  CHECK(fovea::HiddenQuarters(patches, measured, reference, {0, 4}) ==
+        std::vector<std::uint8_t>(4, 0));
+  // Marked: a patch with a hidden quarter stays in the map and leaves its
+  // reference view.
+  fovea::PatchMap marked = patches;
+  CHECK(fovea::MarkHiddenFromReference(&marked, measured, reference, check) == 2);
+  REQUIRE(marked.size() == 4);
+  for (int i = 0; i < 4; ++i) CHECK(marked[i].hidden_in_reference == (i < 2));
+  const fovea::PatchMap seen = fovea::ReferenceMap(marked);
+  REQUIRE(seen.size() == 2);
+  CHECK(seen[0].Centre().isApprox(patches[2].Centre()));
+  CHECK(seen[1].Centre().isApprox(patches[3].Centre()));
+  // A patch at a wrong depth samples another stretch of texture in the
+  // reference image: 30 cm in front of the far plane, 7 px of parallax (15
+  // mm, four texture cells, on the plane).
+  fovea::PatchMap wrong;
+  wrong.Add(Square(0.05, kFarY - 0.3));
+  CHECK(fovea::HiddenQuarters(wrong, measured, reference, check) == std::vector<std::uint8_t>{15});
+}
+
+TEST_CASE("a patch without texture in its measuring image is not judged", "[fovea][visibility]") {
+  rig::CameraView measured = Camera(0.04);
+  const rig::CameraView reference = Camera(-0.01);
+  measured.gray.setTo(100);
+  fovea::PatchMap patches;
+  patches.Add(Square(-0.025, kFarY));
+  CHECK(fovea::HiddenQuarters(patches, measured, reference, {0.5, 4}) ==
+        std::vector<std::uint8_t>{0});
+}
+
+TEST_CASE(
+    "a patch is hidden by its left or right half, or three quarters, not by a top, bottom or "
+    "lone quarter",
+    "[fovea][visibility]") {
+  // Bits 2 v + u: 1 top-left, 2 top-right, 4 bottom-left, 8 bottom-right.
+  for (const int q : {5, 10, 7, 11, 13, 14, 15}) {
+    CAPTURE(q);
+    CHECK(fovea::HiddenSide(static_cast<std::uint8_t>(q)));
+  }
+  for (const int q : {0, 1, 2, 4, 8, 3, 12, 6, 9}) {
+    CAPTURE(q);
+    CHECK_FALSE(fovea::HiddenSide(static_cast<std::uint8_t>(q)));
+  }
+}
