@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bitset>
 #include <cmath>
 #include <cstdint>
 #include <optional>
@@ -48,9 +49,7 @@ Eigen::Vector3d QuadPoint(const Patch& p, double s, double t) {
 }  // namespace
 
 bool HiddenSide(std::uint8_t quarters) {
-  const int count =
-      ((quarters >> 0) & 1) + ((quarters >> 1) & 1) + ((quarters >> 2) & 1) + ((quarters >> 3) & 1);
-  return (quarters & 5) == 5 || (quarters & 10) == 10 || count >= 3;
+  return (quarters & 5) == 5 || (quarters & 10) == 10 || std::bitset<4>(quarters).count() >= 3;
 }
 
 std::vector<std::uint8_t> HiddenQuarters(const PatchMap& patches, const rig::CameraView& measured,
@@ -97,15 +96,12 @@ int MarkHiddenFromReference(PatchMap* patches, const rig::CameraView& measured,
                             const rig::CameraView& reference,
                             const ReferenceCheckOptions& options) {
   const std::vector<std::uint8_t> hidden = HiddenQuarters(*patches, measured, reference, options);
-  PatchMap marked;
   int count = 0;
   for (size_t i = 0; i < patches->size(); ++i) {
-    Patch p = (*patches)[i];
-    p.hidden_in_reference = HiddenSide(hidden[i]);
-    count += p.hidden_in_reference;
-    marked.Add(p);
+    const bool side = HiddenSide(hidden[i]);
+    patches->SetHiddenInReference(i, side);
+    count += side;
   }
-  *patches = std::move(marked);
   return count;
 }
 

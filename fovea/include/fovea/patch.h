@@ -197,6 +197,9 @@ class PatchMap {
   void Add(const Patch& patch);
   void Append(const PatchMap& other);
   void Clear();
+  /// Sets patch i's Patch::hidden_in_reference, which no query reads: the
+  /// spatial index stays valid.
+  void SetHiddenInReference(size_t i, bool hidden) { patches_[i].hidden_in_reference = hidden; }
   /// Removes the patches whose flag is set (`drop` has one flag per patch);
   /// the others keep their order. Returns how many were removed.
   size_t Remove(const std::vector<char>& drop);
