@@ -60,8 +60,10 @@ struct FovealOptions {
   /// (they still count in its fit): beside an edge whose farther side goes
   /// unmatched (outside the search band, or without texture) the window
   /// still matches the nearer texture over the edge, and no farther match
-  /// shows the jump. 0: none; 7: a window's width at edge_erosion_px 3.
-  int edge_hole_px = 7;
+  /// shows the jump. 0: none. 4 (was 7, a window's width): the half-occluded
+  /// strip beside a nearer surface keeps a few false matches, which cut it
+  /// into shorter runs (README, "The map's trust").
+  int edge_hole_px = 4;
   /// Beyond the paper: a block becomes one patch only if its inliers fill
   /// enough of it, else it is split into quarters, and a patch covers only
   /// its inliers' extent, so that no patch reaches over a depth edge or a
