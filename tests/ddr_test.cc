@@ -147,7 +147,10 @@ TEST_CASE(
                f25 = records.back()["score"]["foveal_coverage"];
   CHECK(f25 > f1);
   CHECK(s["median_rel_error"].get<double>() < 0.01);
-  CHECK(s["coverage"].get<double>() >= 0.95);  // measured 0.994 (2 levels)
+  // Measured 0.994 (2 levels); since foveal.edge_hole_px 4 the strips along
+  // the near plane's edge stay empty rather than wrong: 0.942 in the release
+  // build (RMSE 15.5 -> 3.8 mm), 0.945 in the sanitizer build.
+  CHECK(s["coverage"].get<double>() >= 0.93);
   // No IDR patch outlives finer data covering it in the reference view
   // (retired in the IDR view alone, 15 did here).
   CHECK(s["stale_idr_patches"] == 0);
