@@ -129,3 +129,45 @@ TEST_CASE(
     CHECK_FALSE(fovea::HiddenSide(static_cast<std::uint8_t>(q)));
   }
 }
+
+TEST_CASE(
+    "on a faint texture, too faint for a quarter to be judged, the pooled samples of a half or "
+    "of the whole patch judge it",
+    "[fovea][visibility]") {
+  // The scene's contrast cut to 8.5% and sensor noise of 2 grey levels
+  // added (independent per camera): each quarter's samples vary by less
+  // than 4 grey levels and go unjudged (the near plane's by about 3.6, the
+  // far plane's coarser texture by 2.6). Pooled over a half or the whole
+  // patch, with the pooled threshold at 2.3 grey levels so that the far
+  // plane's patches are judged too, the hidden first patch and the hidden
+  // half of the second correlate at -0.09 to 0.15, what the reference
+  // camera sees at 0.67 to 0.83, and the second patch as a whole at 0.35.
+  auto faint = [](rig::CameraView view, std::uint64_t seed) {
+    cv::Mat noise(view.gray.size(), CV_32F);
+    cv::RNG rng(seed);
+    rng.fill(noise, cv::RNG::NORMAL, 0, 2);
+    cv::Mat f;
+    view.gray.convertTo(f, CV_32F, 0.085, 128 - 0.085 * 128);
+    f += noise;
+    f.convertTo(view.gray, CV_8U);
+    return view;
+  };
+  const rig::CameraView measured = faint(Camera(0.04), 1), reference = faint(Camera(-0.01), 2);
+  fovea::PatchMap patches;
+  patches.Add(Square(-0.025, kFarY));  // seen past the edge by the measuring camera only
+  patches.Add(Square(0.012, kFarY));   // its left half behind the near plane from the reference
+  patches.Add(Square(0.05, kFarY));    // the far plane both see
+  patches.Add(Square(-0.05, kNearY));  // the near plane
+  fovea::ReferenceCheckOptions check{0.5, 4};
+  // Quarters only: none can be judged.
+  CHECK(fovea::HiddenQuarters(patches, measured, reference, check) ==
+        std::vector<std::uint8_t>(4, 0));
+  check.pooled_min_ncc = 0.2;
+  check.pooled_min_texture_dn = 2.3;
+  CHECK(fovea::HiddenQuarters(patches, measured, reference, check) ==
+        std::vector<std::uint8_t>{15, 5, 0, 0});
+  // Without texture at all the pooled samples are not judged either.
+  rig::CameraView flat = measured;
+  flat.gray.setTo(100);
+  CHECK(fovea::HiddenQuarters(patches, flat, reference, check) == std::vector<std::uint8_t>(4, 0));
+}

@@ -358,6 +358,7 @@ void AddDdrParams(RunConfig* c, std::vector<ConfigParam>* params) {
           {&fp::kIntegrationRetireIdrShare, &f.integration.retire_idr_share},
           {&fp::kIntegrationRetireInFixationView, &f.integration.retire_in_fixation_view},
           {&fp::kIntegrationReferenceMinNcc, &f.integration.reference_min_ncc},
+          {&fp::kIntegrationReferencePooledMinNcc, &f.integration.reference_pooled_min_ncc},
       });
 }
 

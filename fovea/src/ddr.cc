@@ -150,6 +150,14 @@ void RecordFixation(const FixationResult& r, FixationRecord* rec) {
   for (const LevelFigures& l : r.foveal.levels) rec->time.match_s += l.match_time_s;
 }
 
+// The reference check that IntegrationOptions asks for.
+ReferenceCheckOptions ReferenceCheck(const IntegrationOptions& integration) {
+  ReferenceCheckOptions check;
+  check.min_ncc = integration.reference_min_ncc;
+  check.pooled_min_ncc = integration.reference_pooled_min_ncc;
+  return check;
+}
+
 // Merges a fixation's patches into the map (timed as integration) and moves
 // the loop on to the fixation's view.
 void Absorb(const FixationResult& r, const rig::CameraView& idr_view,
@@ -159,7 +167,7 @@ void Absorb(const FixationResult& r, const rig::CameraView& idr_view,
   state->frame = r.servo.frame;
   PatchMap fresh = r.foveal.patches;
   const int hidden = reference ? MarkHiddenFromReference(&fresh, state->frame.left, *reference,
-                                                         {integration.reference_min_ncc})
+                                                         ReferenceCheck(integration))
                                : 0;
   rec->integration = Integrate(&run->map, fresh, state->frame.left, integration);
   rec->integration.hidden_in_reference = hidden;
@@ -236,7 +244,7 @@ FoveaRun RunFovea(rig::Rig& rig, const StereoMatcher& matcher, const FoveaOption
   if (reference) {
     const auto t = Clock::now();
     run.idr_hidden = MarkHiddenFromReference(&run.map, run.idr.final_frame.left, *reference,
-                                             {options.integration.reference_min_ncc});
+                                             ReferenceCheck(options.integration));
     run.compute_time_s += Since(t);
   }
   if (options.selection.first_fixation == "idr" && !run.idr.has_fixation) {

@@ -15,6 +15,7 @@ void IntegrationOptions::Check() const {
   rig::CheckParam(params::kIntegrationRetireIdrShare, retire_idr_share);
   rig::CheckParam(params::kIntegrationContradictionShare, contradiction_share);
   rig::CheckParam(params::kIntegrationReferenceMinNcc, reference_min_ncc);
+  rig::CheckParam(params::kIntegrationReferencePooledMinNcc, reference_pooled_min_ncc);
 }
 
 namespace {

@@ -33,6 +33,11 @@ struct NccSums {
     a += x, b += y, aa += x * x, bb += y * y, ab += x * y;
   }
   double VarA() const { return n ? aa / n - (a / n) * (a / n) : 0; }
+  NccSums& operator+=(const NccSums& o) {
+    n += o.n;
+    a += o.a, b += o.b, aa += o.aa, bb += o.bb, ab += o.ab;
+    return *this;
+  }
   double Ncc() const {
     const double va = aa - a * a / n, vb = bb - b * b / n, cov = ab - a * b / n;
     return va > 0 && vb > 0 ? cov / std::sqrt(va * vb) : 0;
@@ -87,6 +92,22 @@ std::vector<std::uint8_t> HiddenQuarters(const PatchMap& patches, const rig::Cam
       const NccSums& sums = quarter[q];
       if (4 * sums.n < 3 * tried[q] || sums.VarA() < min_var) continue;
       if (sums.Ncc() < options.min_ncc) hidden[i] |= std::uint8_t(1u << q);
+    }
+    if (options.pooled_min_ncc <= 0) continue;
+    // The left and the right column of quarters, then the whole patch.
+    const double pooled_min_var = options.pooled_min_texture_dn * options.pooled_min_texture_dn;
+    for (const std::uint8_t group : {std::uint8_t{5}, std::uint8_t{10}, std::uint8_t{15}}) {
+      NccSums sums;
+      int tried_group = 0;
+      for (int q = 0; q < 4; ++q)
+        if (group & (1u << q)) {
+          sums += quarter[q];
+          tried_group += tried[q];
+        }
+      if ((hidden[i] & group) == group || 4 * sums.n < 3 * tried_group ||
+          sums.n < ReferenceCheckOptions::kMinPooledSamples || sums.VarA() < pooled_min_var)
+        continue;
+      if (sums.Ncc() < options.pooled_min_ncc) hidden[i] |= group;
     }
   }
   return hidden;

@@ -399,6 +399,13 @@ inline constexpr ParamSpec kIntegrationReferenceMinNcc{
     "sampled on its plane, is below this in its left or right half or three of its quarters (a "
     "farther surface seen past a nearer one's edge from another viewpoint; 0 = no check)",
     0, 1};
+inline constexpr ParamSpec kIntegrationReferencePooledMinNcc{
+    "integration.reference_pooled_min_ncc",
+    "beyond the paper: with integration.reference_min_ncc, a patch's left or right half, or the "
+    "whole patch, is hidden from the reference camera when the cross-correlation of all its "
+    "samples is below this (a faint texture, whose quarters vary too little to be judged on "
+    "their own; 0 = quarters only)",
+    0, 1};
 inline constexpr ParamSpec kLoopFixations{"loop.fixations", "successful fixations to make", 1,
                                           10000};
 inline constexpr ParamSpec kLoopStayInIdrView{

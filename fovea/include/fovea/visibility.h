@@ -29,6 +29,17 @@ struct ReferenceCheckOptions {
   /// A quarter whose samples in the measuring image vary less than this
   /// (standard deviation, grey levels) cannot be judged and passes.
   double min_texture_dn = 4;
+  /// Beyond the quarters: the samples of each half across the patch (its
+  /// left and its right column of quarters) and of the whole patch, pooled,
+  /// are judged alike where they vary by at least `pooled_min_texture_dn`
+  /// and number at least kMinPooledSamples: all the group's quarters are
+  /// hidden when their normalized cross-correlation is below this. A faint
+  /// texture (sensor noise a large part of its variation) leaves each
+  /// quarter's few samples unjudged, and the occluded strip beside a box
+  /// goes unnoticed; pooled, the samples judge it. 0: quarters only.
+  double pooled_min_ncc = 0;
+  double pooled_min_texture_dn = 3;
+  static constexpr int kMinPooledSamples = 32;
 };
 
 /// Per patch of `patches` (in order), a bit per quarter (bit 2 v + u for
@@ -37,7 +48,8 @@ struct ReferenceCheckOptions {
 /// ReferenceCheckOptions, its texture sampled on the patch's plane in
 /// `measured` (the image its footprint was matched in) and in `reference`.
 /// A quarter is judged where at least 3/4 of its samples fall inside both
-/// images, else it passes. Samples per patch: its size in `measured` in
+/// images, else it passes; then the pooled groups (pooled_min_ncc).
+/// Samples per patch: its size in `measured` in
 /// pixels, squared (4 to 32 per side). Cost: O(samples).
 std::vector<std::uint8_t> HiddenQuarters(const PatchMap& patches, const rig::CameraView& measured,
                                          const rig::CameraView& reference,
