@@ -42,6 +42,13 @@ struct NccSums {
     const double va = aa - a * a / n, vb = bb - b * b / n, cov = ab - a * b / n;
     return va > 0 && vb > 0 ? cov / std::sqrt(va * vb) : 0;
   }
+  /// Whether these samples, of `tried` sample points, are judged (at least
+  /// 3/4 of them fell inside both images, at least `min_n` in all, and they
+  /// vary by at least `min_var` in the measuring image) and correlate below
+  /// `min_ncc`: the part they cover is hidden from the reference camera.
+  bool Uncorrelated(int tried, double min_var, double min_ncc, int min_n = 0) const {
+    return 4 * n >= 3 * tried && n >= min_n && VarA() >= min_var && Ncc() < min_ncc;
+  }
 };
 
 // The point of a patch at (s, t) in [0, 1]^2, bilinear between its corners
@@ -88,11 +95,9 @@ std::vector<std::uint8_t> HiddenQuarters(const PatchMap& patches, const rig::Cam
         const auto gm = SampleGray(measured.gray, *pm), gr = SampleGray(reference.gray, *pr);
         if (gm && gr) quarter[q].Add(*gm, *gr);
       }
-    for (int q = 0; q < 4; ++q) {
-      const NccSums& sums = quarter[q];
-      if (4 * sums.n < 3 * tried[q] || sums.VarA() < min_var) continue;
-      if (sums.Ncc() < options.min_ncc) hidden[i] |= std::uint8_t(1u << q);
-    }
+    for (int q = 0; q < 4; ++q)
+      if (quarter[q].Uncorrelated(tried[q], min_var, options.min_ncc))
+        hidden[i] |= std::uint8_t(1u << q);
     if (options.pooled_min_ncc <= 0) continue;
     // The left and the right column of quarters, then the whole patch.
     const double pooled_min_var = options.pooled_min_texture_dn * options.pooled_min_texture_dn;
@@ -104,10 +109,10 @@ std::vector<std::uint8_t> HiddenQuarters(const PatchMap& patches, const rig::Cam
           sums += quarter[q];
           tried_group += tried[q];
         }
-      if ((hidden[i] & group) == group || 4 * sums.n < 3 * tried_group ||
-          sums.n < ReferenceCheckOptions::kMinPooledSamples || sums.VarA() < pooled_min_var)
-        continue;
-      if (sums.Ncc() < options.pooled_min_ncc) hidden[i] |= group;
+      if ((hidden[i] & group) != group &&
+          sums.Uncorrelated(tried_group, pooled_min_var, options.pooled_min_ncc,
+                            ReferenceCheckOptions::kMinPooledSamples))
+        hidden[i] |= group;
     }
   }
   return hidden;

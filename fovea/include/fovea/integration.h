@@ -49,7 +49,7 @@ struct IntegrationOptions {
   /// none is): kept in the map, left out of its depth in the reference view.
   double reference_min_ncc = 0.5;
   /// ReferenceCheckOptions::pooled_min_ncc of that check (0: quarters
-  /// only). 0.2: on faint textures (wall and floor behind the catalog's
+  /// only). 0.2: on faint textures (the wall behind `three_surfaces`'
   /// boxes) the farther surface seen past a nearer one's edge went
   /// unnoticed, quarter by quarter; over the accuracy benchmark the pooled
   /// check took wrong pixels 0.51% -> 0.43% and the largest edge_bad_share

@@ -48,9 +48,9 @@ struct ReferenceCheckOptions {
 /// ReferenceCheckOptions, its texture sampled on the patch's plane in
 /// `measured` (the image its footprint was matched in) and in `reference`.
 /// A quarter is judged where at least 3/4 of its samples fall inside both
-/// images, else it passes; then the pooled groups (pooled_min_ncc).
-/// Samples per patch: its size in `measured` in
-/// pixels, squared (4 to 32 per side). Cost: O(samples).
+/// images, else it passes; then the pooled groups (pooled_min_ncc). Samples
+/// per patch: its size in `measured` in pixels, squared (4 to 32 per side).
+/// Cost: O(samples).
 std::vector<std::uint8_t> HiddenQuarters(const PatchMap& patches, const rig::CameraView& measured,
                                          const rig::CameraView& reference,
                                          const ReferenceCheckOptions& options);
