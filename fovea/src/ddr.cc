@@ -147,6 +147,7 @@ void RecordFixation(const FixationResult& r, FixationRecord* rec) {
   rec->fovea = r.foveal.Fovea();
   rec->levels = r.foveal.levels;
   rec->time.foveal_s = r.foveal.compute_time_s;
+  rec->time.match_s = r.foveal.silent_check_time_s;
   for (const LevelFigures& l : r.foveal.levels) rec->time.match_s += l.match_time_s;
 }
 

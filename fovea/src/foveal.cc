@@ -598,6 +598,7 @@ FovealResult FovealStereo(const FixationFrame& matched, const Eigen::Vector3d& f
   // Coarse to fine: each level's search starts from the coarser one's estimate.
   for (int index = levels - 1; index >= 0; --index) {
     const auto t0 = Clock::now();
+    const double silent_before = result.silent_check_time_s;
     Level level = MakeLevel(frame, t, index);
     level.rect = matched_here(index);
     const cv::Mat* coarse = index + 1 < levels ? &result.disparity_px[index + 1] : nullptr;
@@ -622,7 +623,9 @@ FovealResult FovealStereo(const FixationFrame& matched, const Eigen::Vector3d& f
     else
       fig.patches =
           LevelPatches(frame, level, inner, dm.disparity_px, options, fixation, &result.patches);
-    fig.match_time_s = Since(t0);
+    // The rectified periphery's wide search is counted in
+    // silent_check_time_s, not twice.
+    fig.match_time_s = Since(t0) - (result.silent_check_time_s - silent_before);
     result.disparity_px[index] = dm.disparity_px;
   }
   result.compute_time_s = Since(t_start);

@@ -36,25 +36,50 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 // The level is matched in strips of this many rows; each disparity's costs
 // span only the columns some pixel of the strip needs them at.
 constexpr int kStripRows = 16;
+// Within a row, the columns are grouped in chunks of this many (chunk k:
+// [k * kChunkCols, (k + 1) * kChunkCols) of the matched crop), the block of
+// columns the paper's cost sums in registers (FillWindowMean).
+constexpr int kChunkCols = 16;
 
 // The matching costs of one strip of rows: the cost at (x, y, d) is that of
 // the left window centred at (x, y) against the right window at (x - d, y),
 // +inf where the right window leaves the image. Each disparity d holds the
 // columns [x0[d], x0[d] + width[d]), x fastest (Row). Row y needs d only
-// over [RowFirst(y, d), RowEnd(y, d)), a part of those (empty: first >=
-// end); a fill that costs O(window area) computes only that part.
+// over its runs (ForRuns): the columns of the chunks in which some pixel's
+// band holds d, adjacent chunks merged (and runs narrower than a chunk
+// widened to one where the image allows). The fills compute and the
+// searches read only those: elsewhere a row's costs are not set (the fills
+// that box-sum whole rows set them all). Beside a depth edge a row's
+// pixels search disparities far apart, and its hull of each disparity's
+// columns held 2.7 times the cells its pixels need (cylinder_planes, the
+// full-resolution periphery).
 struct CostVolume {
   int y0 = 0, rows = 0, dlo = 0, nd = 0;
   std::vector<int> x0, width;
   std::vector<size_t> offset;
   std::vector<float> c;
-  std::vector<int> row_first, row_end;  ///< [(y - y0) * nd + d - dlo]
+  /// Columns [begin, end) of a row; the next run of the same row and
+  /// disparity (-1: none).
+  struct Run {
+    int begin, end, next;
+  };
+  std::vector<Run> runs;
+  std::vector<int> head, tail;  ///< [(y - y0) * nd + d - dlo]: first and last run, -1: none
   float* Row(int y, int d) {
     const int i = d - dlo;
     return &c[offset[i] + static_cast<size_t>(y - y0) * width[i]];
   }
-  int RowFirst(int y, int d) const { return row_first[(y - y0) * nd + d - dlo]; }
-  int RowEnd(int y, int d) const { return row_end[(y - y0) * nd + d - dlo]; }
+  /// The first run of row y at disparity d (-1: none).
+  int Head(int y, int d) const { return head[static_cast<size_t>(y - y0) * nd + d - dlo]; }
+  /// The last run of row y at disparity d (one exists).
+  const Run& Last(int y, int d) const {
+    return runs[tail[static_cast<size_t>(y - y0) * nd + d - dlo]];
+  }
+  /// f(begin, end) for each run of row y at disparity d, left to right.
+  template <typename F>
+  void ForRuns(int y, int d, F&& f) const {
+    for (int r = Head(y, d); r >= 0; r = runs[r].next) f(runs[r].begin, runs[r].end);
+  }
 };
 
 // The rows of a strip and their windows, per disparity d, for the
@@ -194,88 +219,177 @@ FOVEA_SIMD_CLONES void FillZeroMeanSsd(const cv::Mat& l, const cv::Mat& r, int h
   }
 }
 
-// Eight floats (GCC's vector extensions: one AVX2 register in the AVX2
-// clone, two SSE registers otherwise), for sums the compiler does not keep
-// in registers itself. Loaded and stored with memcpy; |v| by clearing the
-// sign bit, as std::abs does.
-typedef float Floats8 __attribute__((vector_size(32)));
-typedef int32_t Ints8 __attribute__((vector_size(32)));
+// Sixteen 16-bit integers (GCC's vector extensions: one AVX2 register in
+// the AVX2 clone, two SSE registers otherwise), for sums the compiler does
+// not keep in registers itself. Loaded and stored with memcpy.
+typedef int16_t Shorts16 __attribute__((vector_size(32)));
+
+// The paper's cost, sum_i |D_i - o| over the window's n = (2h + 1)^2
+// pixels, with D = L - R and o = S / n their mean (S = sum_i D_i: the two
+// windows' sums less each other), in exact integers. With q = floor(o),
+// r = S - n q in [0, n) and e_i = D_i - q:
+//   sum_i |D_i - o| = sum_i |e_i - r / n|
+//                   = 2 A - r - (r / n) (2 P - n),
+// where A = sum_i max(e_i, 0) = sum_i max(D_i, q) - n q and P counts the
+// e_i > 0 (for an integer e_i and 0 <= r / n < 1, |e_i - r / n| is
+// e_i - r / n where e_i > 0 and r / n - e_i elsewhere; sum_i e_i = r). So n
+// times the sum is the integer n (2 A - r) - r (2 P - n), and the cost,
+// the mean absolute difference, is that over n^2: one rounding, in float.
+// For 8-bit images and a window of at most 11 x 11 pixels
+// (kMaxBlockHalfPx), sum_i max(D_i, q) and P fit 16-bit integers: 16
+// columns per AVX2 register, where float sums held 8.
+struct WindowMeanCost {
+  int n;         ///< pixels in the window
+  float inv_n2;  ///< 1 / n^2
+  /// The cost from sum_i max(D_i, q), P, the window's S and q.
+  float operator()(int sum_max, int positive, int s, int q) const {
+    const int64_t a = sum_max - int64_t{n} * q, r = s - int64_t{n} * q;
+    return static_cast<float>(n * (2 * a - r) - r * (2 * positive - n)) * inv_n2;
+  }
+};
+// The largest window half width whose sums fit 16-bit integers: n * 255
+// <= 32767 for n = (2h + 1)^2.
+constexpr int kMaxBlockHalfPx = 5;
+
+// The paper's cost at 16 adjacent columns. `row0`: the differences D = L -
+// R of the window's first row, from its first column, rows `span` apart;
+// `s`, `q`: each column's S and floor(S / n); `out`: the costs. The window
+// half width is kHalf, or h where kHalf is 0 (for the default window the
+// compiler unrolls the loops). sum_i max(D_i, q) is taken as the sum of
+// the D_i above q plus q for each of the others.
+template <int kHalf>
+inline __attribute__((always_inline)) void WindowBlock(const int16_t* row0, int span, const int* s,
+                                                       const int16_t* q, int h,
+                                                       const WindowMeanCost& cost, float* out) {
+  const int half = kHalf > 0 ? kHalf : h;
+  Shorts16 m, above_sum = {}, not_above = {};
+  std::memcpy(&m, q, sizeof m);
+  for (int dy = 0; dy <= 2 * half; ++dy) {
+    const int16_t* pd = row0 + static_cast<size_t>(dy) * span;
+    for (int dx = 0; dx <= 2 * half; ++dx) {
+      Shorts16 l;
+      std::memcpy(&l, pd + dx, sizeof l);
+      const Shorts16 above = l > m;  // -1 where D_i > q
+      above_sum += l & above;
+      not_above += above;  // minus P
+    }
+  }
+  // The costs, in 32-bit integers (at most 11 x 11 pixels: n (2 A - r) <
+  // 2^24) and one rounding: the same as WindowMeanCost's.
+  int16_t sa[16], na[16];
+  std::memcpy(sa, &above_sum, sizeof sa);
+  std::memcpy(na, &not_above, sizeof na);
+  const int n = cost.n;
+  for (int i = 0; i < 16; ++i) {
+    // A = sum_i max(D_i, q) - n q = (D_i above q) + (n - P) q - n q.
+    const int a = sa[i] + na[i] * q[i], r = s[i] - n * q[i];
+    out[i] = static_cast<float>(n * (2 * a - r) + r * (2 * na[i] + n)) * cost.inv_n2;
+  }
+}
 
 // The paper's cost: sum |(L - mean L) - (R - mean R)| with both means over
 // the windows being compared, which no running sum can share: O(window
 // area) per pixel and disparity. Per disparity, the strip's differences
-// L - R are taken once; each row then sums |(L - R) - (mean L - mean R)|
-// over the window only at the columns it needs (CostVolume::RowFirst), the
-// window's offsets a loop over contiguous columns that the compiler
-// vectorizes (each pixel's sum in the same order as one pixel at a time).
-// `l`, `r`: the images as CV_32F; `ml`, `mr`: their window means.
-FOVEA_SIMD_CLONES void FillWindowMean(const cv::Mat& l, const cv::Mat& r, const cv::Mat& ml,
-                                      const cv::Mat& mr, int h, CostVolume* v) {
-  const float scale = 1.0f / ((2 * h + 1) * (2 * h + 1));
+// L - R are taken once; each row then sums over the window only at the
+// columns it needs (CostVolume::ForRuns), in exact integers
+// (WindowMeanCost): blocks of 16 columns (WindowBlock), the columns of a
+// row too narrow for one, or of a window too wide for 16-bit sums, a
+// column at a time with the same integers.
+// `l`, `r`: the 8-bit images; `sl`, `sr`: their window sums (CV_32S).
+FOVEA_SIMD_CLONES void FillWindowMean(const cv::Mat& l, const cv::Mat& r, const cv::Mat& sl,
+                                      const cv::Mat& sr, int h, CostVolume* v) {
   const int cols = l.cols;
-  std::vector<float> diff, offset, acc;
+  const WindowMeanCost cost{
+      (2 * h + 1) * (2 * h + 1),
+      1.0f / static_cast<float>((2 * h + 1) * (2 * h + 1) * (2 * h + 1) * (2 * h + 1))};
+  const float inv_n = 1.0f / static_cast<float>(cost.n);
+  std::vector<int16_t> diff, q;
+  std::vector<int> s;
   for (int d = v->dlo; d < v->dlo + v->nd; ++d) {
     const int x0 = v->x0[d - v->dlo], width = v->width[d - v->dlo];
     if (width <= 0) continue;
     // Right windows inside the image: x - d - h >= 0 and x - d + h < cols.
     const int valid0 = std::clamp(d + h - x0, 0, width);
     const int valid1 = std::clamp(cols + d - h - x0, valid0, width);
-    // L - R over the strip's rows and their windows; the windows of the
-    // columns [valid0, valid1) only read where the right pixel lies in the
-    // image.
-    const int span = width + 2 * h;
-    StripDifferences<float>(
-        l, r, *v, d, h, x0, span, [](float p, float q) { return p - q; }, &diff);
-    offset.resize(width);
-    acc.resize(width);
+    // L - R over the strip's rows and their windows, each row of
+    // differences only over the columns the windows of its rows' runs read
+    // (the rows' first run's first column to their last run's end), and
+    // only where the right pixel lies in the image (the columns [valid0,
+    // valid1) read no other).
+    const int span = width + 2 * h, rows = v->rows + 2 * h;
+    diff.resize(static_cast<size_t>(rows) * span);
+    for (int row = 0; row < rows; ++row) {
+      int a = span, b = 0;
+      // The rows whose windows hold it: y - y0 <= row <= y - y0 + 2h.
+      for (int y = std::max(v->y0, v->y0 + row - 2 * h);
+           y <= std::min(v->y0 + v->rows - 1, v->y0 + row); ++y) {
+        const int first = v->Head(y, d);
+        if (first < 0) continue;
+        a = std::min(a, v->runs[first].begin - x0);
+        b = std::max(b, v->Last(y, d).end - x0 + 2 * h);
+      }
+      a = std::max(a, valid0);
+      b = std::min(b, valid1 + 2 * h);
+      const uchar* __restrict pl = l.ptr<uchar>(v->y0 - h + row) + (x0 - h);
+      const uchar* __restrict pr = r.ptr<uchar>(v->y0 - h + row) + (x0 - h - d);
+      int16_t* __restrict pd = &diff[static_cast<size_t>(row) * span];
+      for (int i = a; i < b; ++i) pd[i] = static_cast<int16_t>(int16_t{pl[i]} - int16_t{pr[i]});
+    }
+    s.resize(width);
+    q.resize(width);
     for (int y = v->y0; y < v->y0 + v->rows; ++y) {
       float* out = v->Row(y, d);
-      // The row's columns, as offsets into the strip's [x0, x0 + width).
-      const int c0 = std::clamp(v->RowFirst(y, d) - x0, valid0, valid1);
-      const int c1 = std::clamp(v->RowEnd(y, d) - x0, c0, valid1);
-      std::fill(out, out + c0, kInf);
-      std::fill(out + c1, out + width, kInf);
-      const int n = c1 - c0;
-      if (n <= 0) continue;
-      const float* __restrict pml = ml.ptr<float>(y) + x0 + c0;
-      const float* __restrict pmr = mr.ptr<float>(y) + x0 + c0 - d;
-      float* __restrict o = offset.data();
-      for (int i = 0; i < n; ++i) o[i] = pml[i] - pmr[i];
-      // diff's row of y - h + dy, from the column x0 + c0 - h.
-      const float* row0 = &diff[static_cast<size_t>(y - v->y0) * span] + c0;
-      // Blocks of 16 columns, their sums held in two registers of 8 floats
-      // over the whole window (GCC's vector extensions: AVX2 registers in
-      // the AVX2 clone); then the columns left, one pass per window offset.
-      // Both add the window's terms in the same order.
-      int i0 = 0;
-      for (; i0 + 16 <= n; i0 += 16) {
-        Floats8 c_lo = {}, c_hi = {}, o_lo, o_hi, l_lo, l_hi;
-        std::memcpy(&o_lo, o + i0, sizeof o_lo);
-        std::memcpy(&o_hi, o + i0 + 8, sizeof o_hi);
-        for (int dy = 0; dy <= 2 * h; ++dy) {
-          const float* pd = row0 + static_cast<size_t>(dy) * span + i0;
-          for (int dx = 0; dx <= 2 * h; ++dx) {
-            std::memcpy(&l_lo, pd + dx, sizeof l_lo);
-            std::memcpy(&l_hi, pd + dx + 8, sizeof l_hi);
-            c_lo += reinterpret_cast<Floats8>(reinterpret_cast<Ints8>(l_lo - o_lo) & 0x7fffffff);
-            c_hi += reinterpret_cast<Floats8>(reinterpret_cast<Ints8>(l_hi - o_hi) & 0x7fffffff);
+      // The runs, in a loop rather than through ForRuns: a lambda would be
+      // built for the baseline instruction set only. Their columns whose
+      // right window leaves the image cost +inf; no band reads any other
+      // column outside them.
+      for (int run = v->Head(y, d); run >= 0; run = v->runs[run].next) {
+        // The run's columns, as offsets into the strip's [x0, x0 + width).
+        const int begin = v->runs[run].begin - x0, end = v->runs[run].end - x0;
+        const int c0 = std::clamp(begin, valid0, valid1), c1 = std::clamp(end, c0, valid1);
+        std::fill(out + begin, out + c0, kInf);
+        std::fill(out + c1, out + end, kInf);
+        const int n = c1 - c0;
+        if (n <= 0) continue;
+        const int* __restrict psl = sl.ptr<int>(y) + x0 + c0;
+        const int* __restrict psr = sr.ptr<int>(y) + x0 + c0 - d;
+        int* __restrict ps = s.data();
+        int16_t* __restrict pq = q.data();
+        for (int i = 0; i < n; ++i) {
+          ps[i] = psl[i] - psr[i];
+          // floor(S / n) = floor((S + 1/2) / n) for an integer S, and
+          // (S + 1/2) / n lies at least 1 / 2n from an integer, further
+          // than the float product's error and the rounding of the sum
+          // below (|S| / n <= 255). Shifted by 256 to be positive, the
+          // conversion's truncation is the floor.
+          pq[i] = static_cast<int16_t>(
+              static_cast<int>((static_cast<float>(ps[i]) + 0.5f) * inv_n + 256.0f) - 256);
+        }
+        // diff's row of y - h + dy, from the column x0 + c0 - h.
+        const int16_t* row0 = &diff[static_cast<size_t>(y - v->y0) * span] + c0;
+        // Blocks of 16 columns (SizeVolume widens narrower runs where it
+        // can); the last columns of a run as a block that overlaps the one
+        // before (the same costs again).
+        const bool blocks = h <= kMaxBlockHalfPx && n >= 16;
+        for (int i0 = 0; blocks && i0 < n; i0 += 16) {
+          const int at = std::min(i0, n - 16);
+          if (h == 3)
+            WindowBlock<3>(row0 + at, span, ps + at, pq + at, h, cost, out + c0 + at);
+          else
+            WindowBlock<0>(row0 + at, span, ps + at, pq + at, h, cost, out + c0 + at);
+        }
+        if (!blocks)
+          for (int i = 0; i < n; ++i) {
+            int sum_max = 0, positive = 0;
+            for (int dy = 0; dy <= 2 * h; ++dy) {
+              const int16_t* pd = row0 + static_cast<size_t>(dy) * span + i;
+              for (int dx = 0; dx <= 2 * h; ++dx) {
+                sum_max += std::max<int>(pd[dx], pq[i]);
+                positive += pd[dx] > pq[i];
+              }
+            }
+            out[c0 + i] = cost(sum_max, positive, ps[i], pq[i]);
           }
-        }
-        c_lo *= scale;
-        c_hi *= scale;
-        std::memcpy(out + c0 + i0, &c_lo, sizeof c_lo);
-        std::memcpy(out + c0 + i0 + 8, &c_hi, sizeof c_hi);
-      }
-      if (i0 < n) {
-        float* __restrict c = acc.data();
-        const int m = n - i0;
-        std::fill(c, c + m, 0.0f);
-        for (int dy = 0; dy <= 2 * h; ++dy) {
-          const float* __restrict pd = row0 + static_cast<size_t>(dy) * span + i0;
-          for (int dx = 0; dx <= 2 * h; ++dx)
-            for (int i = 0; i < m; ++i) c[i] += std::abs(pd[i + dx] - o[i0 + i]);
-        }
-        for (int i = 0; i < m; ++i) out[c0 + i0 + i] = c[i] * scale;
       }
     }
   }
@@ -345,8 +459,9 @@ FOVEA_SIMD_CLONES void SearchBands(const cv::Mat& image, const cv::Mat& ml, cons
 }
 
 // Sizes `v` for the strip of rows [y0, y1): the union of its pixels' bands,
-// and for each disparity the columns of the pixels whose band holds it.
-// False when no pixel of the strip is searched.
+// each row's runs of each disparity (CostVolume), and for each disparity the
+// columns of its runs. False when no pixel of the strip is searched.
+// O(cells / kChunkCols) beyond a pass over the bands.
 bool SizeVolume(const Bands& bands, int y0, int y1, int h, CostVolume* v) {
   const int cols = bands.lo.cols;
   int dlo = std::numeric_limits<int>::max(), dhi = std::numeric_limits<int>::min();
@@ -364,59 +479,103 @@ bool SizeVolume(const Bands& bands, int y0, int y1, int h, CostVolume* v) {
   v->rows = y1 - y0;
   v->dlo = dlo;
   v->nd = dhi - dlo + 1;
-  // Per row, a superset of each disparity's columns: scanning left to
-  // right, the first column at which the hull of the bands seen so far
-  // reaches it; scanning back, the last. O(columns + disparities) per row;
-  // a column that does not need d only costs its computation
-  // (RowWinners checks each pixel's own band).
+  v->runs.clear();
+  v->head.assign(static_cast<size_t>(v->rows) * v->nd, -1);
+  v->tail.assign(static_cast<size_t>(v->rows) * v->nd, -1);
   std::vector<int> xmin(v->nd, cols), xmax(v->nd, -1);
-  v->row_first.assign(static_cast<size_t>(v->rows) * v->nd, cols);
-  v->row_end.assign(static_cast<size_t>(v->rows) * v->nd, 0);
-  // Widens the hull [seen_lo, seen_hi] (empty: seen_lo > seen_hi) by the
-  // band [lo, hi], calling mark(d) for each disparity it adds.
-  auto widen = [](int lo, int hi, int* seen_lo, int* seen_hi, auto&& mark) {
-    if (*seen_lo > *seen_hi) {
-      for (int d = lo; d <= hi; ++d) mark(d);
-      *seen_lo = lo;
-      *seen_hi = hi;
-      return;
-    }
-    for (int d = lo; d < *seen_lo; ++d) mark(d);
-    for (int d = *seen_hi + 1; d <= hi; ++d) mark(d);
-    *seen_lo = std::min(*seen_lo, lo);
-    *seen_hi = std::max(*seen_hi, hi);
+  // Scanning a row's chunks left to right, a disparity's run opens at the
+  // first chunk whose band holds it and closes before the first that does
+  // not: only the disparities at which two neighbouring chunks' bands
+  // differ are touched (O(chunks + runs) per row).
+  auto open = [&](size_t row, int d, int first) {
+    const int i = d - dlo;
+    v->runs.push_back({first, 0, -1});
+    const int r = static_cast<int>(v->runs.size()) - 1;
+    int& tail = v->tail[row + i];
+    (tail >= 0 ? v->runs[tail].next : v->head[row + i]) = r;
+    tail = r;
+  };
+  auto close = [&](size_t row, int d, int end) {
+    const int i = d - dlo;
+    v->runs[v->tail[row + i]].end = end;
   };
   for (int y = y0; y < y1; ++y) {
     const int* lo = bands.lo.ptr<int>(y);
     const int* hi = bands.hi.ptr<int>(y);
-    int* first = &v->row_first[static_cast<size_t>(y - y0) * v->nd];
-    int* end = &v->row_end[static_cast<size_t>(y - y0) * v->nd];
-    int seen_lo = 1, seen_hi = 0;
-    for (int x = h; x < cols - h; ++x)
-      if (lo[x] <= hi[x])
-        widen(lo[x], hi[x], &seen_lo, &seen_hi, [&](int d) { first[d - dlo] = x; });
-    seen_lo = 1;
-    seen_hi = 0;
-    for (int x = cols - h - 1; x >= h; --x)
-      if (lo[x] <= hi[x])
-        widen(lo[x], hi[x], &seen_lo, &seen_hi, [&](int d) { end[d - dlo] = x + 1; });
-    for (int i = 0; i < v->nd; ++i)
-      if (first[i] < end[i]) {
-        xmin[i] = std::min(xmin[i], first[i]);
-        xmax[i] = std::max(xmax[i], end[i] - 1);
+    const size_t row = static_cast<size_t>(y - y0) * v->nd;
+    int prev_lo = 1, prev_hi = 0, prev_end = 0;  // the previous chunk's band and end
+    for (int k = h / kChunkCols; k * kChunkCols < cols - h; ++k) {
+      // The chunk's searched pixels: their columns [first, end) and bands' union.
+      int first = cols, end = 0, blo = std::numeric_limits<int>::max(),
+          bhi = std::numeric_limits<int>::min();
+      for (int x = std::max(h, k * kChunkCols); x < std::min(cols - h, (k + 1) * kChunkCols); ++x)
+        if (lo[x] <= hi[x]) {
+          first = std::min(first, x);
+          end = x + 1;
+          blo = std::min(blo, lo[x]);
+          bhi = std::max(bhi, hi[x]);
+        }
+      if (blo > bhi) {
+        blo = 1;
+        bhi = 0;
       }
+      // Close the runs the chunk's band leaves, open those it enters.
+      for (int d = prev_lo; d <= prev_hi; ++d)
+        if (d < blo || d > bhi)
+          close(row, d, prev_end);
+        else
+          d = bhi;  // [blo, bhi] goes on: skip to its end
+      for (int d = blo; d <= bhi; ++d)
+        if (d < prev_lo || d > prev_hi)
+          open(row, d, first);
+        else
+          d = prev_hi;
+      prev_lo = blo;
+      prev_hi = bhi;
+      if (blo <= bhi) prev_end = end;
+    }
+    for (int d = prev_lo; d <= prev_hi; ++d) close(row, d, prev_end);
   }
+  // A run narrower than a block is widened to one where the image has the
+  // columns (right windows inside it: x - d - h >= 0 and x - d + h <
+  // cols): FillWindowMean computes whole blocks, and the costs beside a
+  // run are true costs that no band reads.
+  for (int y = y0; y < y1; ++y)
+    for (int i = 0; i < v->nd; ++i) {
+      const int d = dlo + i;
+      const int lo = std::max(h, d + h), hi = std::min(cols - h, cols + d - h);
+      int prev = -1;
+      for (int r = v->Head(y, d); r >= 0; r = v->runs[r].next) {
+        CostVolume::Run& run = v->runs[r];
+        // Its columns inside the image [vb, ve), widened; never narrowed
+        // (its columns outside cost +inf).
+        const int vb = std::max(run.begin, lo), ve = std::min(run.end, hi);
+        if (vb < ve && ve - vb < kChunkCols && hi - lo >= kChunkCols) {
+          const int e = std::min(hi, std::max(ve, vb + kChunkCols));
+          run.begin = std::min(run.begin, std::max(lo, e - kChunkCols));
+          run.end = std::max(run.end, e);
+        }
+        xmin[i] = std::min(xmin[i], run.begin);
+        xmax[i] = std::max(xmax[i], run.end - 1);
+        // Widened back over the run before it: one run.
+        if (prev >= 0 && run.begin <= v->runs[prev].end) {
+          v->runs[prev].end = std::max(v->runs[prev].end, run.end);
+          v->runs[prev].next = run.next;
+        } else {
+          prev = r;
+        }
+      }
+      v->tail[static_cast<size_t>(y - y0) * v->nd + i] = prev;
+    }
   v->x0.assign(v->nd, 0);
   v->width.assign(v->nd, 0);
   v->offset.assign(v->nd, 0);
   size_t total = 0;
   for (int i = 0; i < v->nd; ++i) {
     v->offset[i] = total;
-    if (xmax[i] < 0) continue;
+    if (xmax[i] < 0) continue;  // a disparity no pixel's band holds
     v->x0[i] = xmin[i];
-    // A disparity only in a gap the hull bridged (bands [0, 1] then [5, 6])
-    // comes out with its last column before its first: no column needs it.
-    v->width[i] = std::max(0, xmax[i] + 1 - xmin[i]);
+    v->width[i] = xmax[i] + 1 - xmin[i];
     total += static_cast<size_t>(v->rows) * v->width[i];
   }
   v->c.resize(total);
@@ -459,7 +618,8 @@ struct RowWinners {
   std::vector<const float*> row;  ///< row[dd - dlo][x]: this row's cost at (x, dd)
   std::vector<int> x0, x1;        ///< the columns row[dd - dlo] holds
 
-  /// The cost at (x, dd) of the row, +inf where it was not computed.
+  /// The cost at (x, dd) of the row, +inf outside the strip's columns of
+  /// dd; only read where x's band holds dd (inside its runs).
   float At(int x, int dd) const {
     const int i = dd - dlo;
     return i >= 0 && i < nd && x >= x0[i] && x < x1[i] ? row[i][x] : kInf;
@@ -484,21 +644,22 @@ struct RowWinners {
                    ? &v.c[v.offset[i] + static_cast<size_t>(y - v.y0) * v.width[i]] - v.x0[i]
                    : nullptr;
     }
+    // Only each disparity's runs: elsewhere no pixel's band holds it.
     for (int dd = v.dlo; dd < v.dlo + v.nd; ++dd) {
-      const int i = dd - v.dlo, x0 = v.x0[i], x1 = x0 + v.width[i];
-      if (x1 <= x0) continue;
-      const float* c = row[i];
-      // Left pixels x: cost[x], d[x]. Right pixels x - dd: right_cost, right_d.
-      TakeLower(c, lo, hi, dd, x0, x1, cost.data(), d.data());
-      const int r0 = std::max(x0, dd), r1 = std::min(x1, cols + dd);
-      if (r1 > r0) TakeLower(c, lo, hi, dd, r0, r1, right_cost.data() - dd, right_d.data() - dd);
+      const float* c = row[dd - v.dlo];
+      v.ForRuns(y, dd, [&](int x0, int x1) {
+        // Left pixels x: cost[x], d[x]. Right pixels x - dd: right_cost, right_d.
+        TakeLower(c, lo, hi, dd, x0, x1, cost.data(), d.data());
+        const int r0 = std::max(x0, dd), r1 = std::min(x1, cols + dd);
+        if (r1 > r0) TakeLower(c, lo, hi, dd, r0, r1, right_cost.data() - dd, right_d.data() - dd);
+      });
     }
     // The best cost more than one disparity away from the winner.
     for (int dd = v.dlo; dd < v.dlo + v.nd; ++dd) {
-      const int i = dd - v.dlo, x0 = v.x0[i], x1 = x0 + v.width[i];
-      if (x1 <= x0) continue;
-      const float* c = row[i];
-      TakeSecond(c, lo, hi, dd, x0, x1, d.data(), second.data());
+      const float* c = row[dd - v.dlo];
+      v.ForRuns(y, dd, [&](int x0, int x1) {
+        TakeSecond(c, lo, hi, dd, x0, x1, d.data(), second.data());
+      });
     }
   }
 };
@@ -616,12 +777,14 @@ void Nl1Matcher::MatchCrop(const cv::Mat& left, const cv::Mat& right, const cv::
   cv::boxFilter(right, mr, CV_32F, cv::Size(n, n));
   const bool prenormalized = options_.cost == "prenormalized";
   const bool zero_mean_ssd = options_.cost == "zero_mean_ssd";
-  cv::Mat image, right_image, a, b;
+  cv::Mat image, sl, sr, a, b;
   left.convertTo(image, CV_32F);
   if (zero_mean_ssd) {
     // The 8-bit images themselves.
   } else if (!prenormalized) {
-    right.convertTo(right_image, CV_32F);
+    // The 8-bit images and their window sums.
+    cv::boxFilter(left, sl, CV_32S, cv::Size(n, n), cv::Point(-1, -1), false);
+    cv::boxFilter(right, sr, CV_32S, cv::Size(n, n), cv::Point(-1, -1), false);
   } else {
     // Each image less its mean over twice the window: a narrower mean
     // filters away the texture's lower frequencies, and a band that misses
@@ -648,7 +811,7 @@ void Nl1Matcher::MatchCrop(const cv::Mat& left, const cv::Mat& right, const cv::
     else if (zero_mean_ssd)
       FillZeroMeanSsd(left, right, h, &v);
     else
-      FillWindowMean(image, right_image, ml, mr, h, &v);
+      FillWindowMean(left, right, sl, sr, h, &v);
     for (int y = y0; y < y1; ++y) {
       w.Find(v, bands, y);
       MatchRow(bands, y, options_.lr_tolerance_px, &w, &out);

@@ -139,7 +139,7 @@ struct LevelFigures {
   int outside_band =
       0;  ///< band matches dropped: the wider search matched outside (FovealOptions::silent_near_m)
   int eroded = 0;  ///< matches dropped beside a disparity jump (FovealOptions::edge_erosion_px)
-  double match_time_s = 0;
+  double match_time_s = 0;  ///< search ranges, matching and patches; the wide search aside
 };
 
 /// The fovea at one fixation: level 0's rectangle, in pixels of the frame
