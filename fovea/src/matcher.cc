@@ -241,10 +241,15 @@ typedef int16_t Shorts16 __attribute__((vector_size(32)));
 struct WindowMeanCost {
   int n;         ///< pixels in the window
   float inv_n2;  ///< 1 / n^2
+  /// The cost from A, r and P, in integers of type Int: 32-bit for windows
+  /// of at most 11 x 11 pixels (n (2 A - r) < 2^24), 64-bit beyond.
+  template <typename Int>
+  float FromParts(Int a, Int r, Int positive) const {
+    return static_cast<float>(n * (2 * a - r) - r * (2 * positive - n)) * inv_n2;
+  }
   /// The cost from sum_i max(D_i, q), P, the window's S and q.
   float operator()(int sum_max, int positive, int s, int q) const {
-    const int64_t a = sum_max - int64_t{n} * q, r = s - int64_t{n} * q;
-    return static_cast<float>(n * (2 * a - r) - r * (2 * positive - n)) * inv_n2;
+    return FromParts<int64_t>(sum_max - int64_t{n} * q, s - int64_t{n} * q, positive);
   }
 };
 // The largest window half width whose sums fit 16-bit integers: n * 255
@@ -274,17 +279,13 @@ inline __attribute__((always_inline)) void WindowBlock(const int16_t* row0, int 
       not_above += above;  // minus P
     }
   }
-  // The costs, in 32-bit integers (at most 11 x 11 pixels: n (2 A - r) <
-  // 2^24) and one rounding: the same as WindowMeanCost's.
+  // The costs, in 32-bit integers (at most 11 x 11 pixels).
   int16_t sa[16], na[16];
   std::memcpy(sa, &above_sum, sizeof sa);
   std::memcpy(na, &not_above, sizeof na);
-  const int n = cost.n;
-  for (int i = 0; i < 16; ++i) {
+  for (int i = 0; i < 16; ++i)
     // A = sum_i max(D_i, q) - n q = (D_i above q) + (n - P) q - n q.
-    const int a = sa[i] + na[i] * q[i], r = s[i] - n * q[i];
-    out[i] = static_cast<float>(n * (2 * a - r) + r * (2 * na[i] + n)) * cost.inv_n2;
-  }
+    out[i] = cost.FromParts<int>(sa[i] + na[i] * q[i], s[i] - cost.n * q[i], -na[i]);
 }
 
 // The paper's cost: sum |(L - mean L) - (R - mean R)| with both means over
@@ -772,9 +773,8 @@ void Nl1Matcher::MatchCrop(const cv::Mat& left, const cv::Mat& right, const cv::
   const int h = options_.window_half_px, n = 2 * h + 1;
   DisparityMap& out = *result;
   if (left.rows < n || left.cols < n) return;
-  cv::Mat ml, mr;
+  cv::Mat ml;  // the left window means, for the texture test
   cv::boxFilter(left, ml, CV_32F, cv::Size(n, n));
-  cv::boxFilter(right, mr, CV_32F, cv::Size(n, n));
   const bool prenormalized = options_.cost == "prenormalized";
   const bool zero_mean_ssd = options_.cost == "zero_mean_ssd";
   cv::Mat image, sl, sr, a, b;
