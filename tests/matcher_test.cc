@@ -327,3 +327,60 @@ TEST_CASE("every NL1 cost matches a shifted texture to a tenth of a pixel", "[fo
   std::nth_element(errs.begin(), errs.begin() + errs.size() / 2, errs.end());
   CHECK(errs[errs.size() / 2] < 0.1);
 }
+
+TEST_CASE("NL1 takes a wider window on a faint texture, and the narrow one elsewhere",
+          "[fovea][matcher]") {
+  // Left half: a strong texture (grey levels 20 to 235); right half: a dark,
+  // faint copy (40 to 58); both views under 2 grey levels of sensor noise.
+  const int rows = 120, cols = 240;
+  const cv::Mat strong = Texture(rows, cols, 21);
+  cv::Mat faint;
+  strong.convertTo(faint, CV_32F, 18.0 / 215, 40);
+  cv::Mat scene;
+  strong.convertTo(scene, CV_32F);
+  faint.colRange(cols / 2, cols).copyTo(scene.colRange(cols / 2, cols));
+  const double d = 4.4;
+  cv::Mat right = Shift(scene, d), left = scene.clone();
+  cv::RNG rng(3);
+  for (cv::Mat* m : {&left, &right}) {
+    cv::Mat noise(rows, cols, CV_32F);
+    rng.fill(noise, cv::RNG::NORMAL, 0, 2);
+    *m += noise;
+    m->convertTo(*m, CV_8U);
+  }
+  const cv::Mat lo(left.size(), CV_32F, cv::Scalar(-4)), hi(left.size(), CV_32F, cv::Scalar(12));
+  fovea::Nl1Options narrow_only;
+  fovea::Nl1Options split = narrow_only;
+  split.weak_window_half_px = 5;
+  split.weak_texture_dn = 8;
+  const auto n = fovea::Nl1Matcher(narrow_only).Match(left, right, lo, hi);
+  const auto s = fovea::Nl1Matcher(split).Match(left, right, lo, hi);
+  CHECK(s.searched == n.searched);
+  // On the faint half the wide window finds the shift at many more pixels,
+  // and no more wrong ones.
+  auto tally = [&](const cv::Mat& disparity, int x0, int x1, int* good, int* wrong) {
+    *good = *wrong = 0;
+    for (int y = 10; y < rows - 10; ++y)
+      for (int x = x0; x < x1; ++x) {
+        const float m = disparity.at<float>(y, x);
+        if (!std::isfinite(m)) continue;
+        ++(std::abs(m - d) < 1 ? *good : *wrong);
+      }
+  };
+  int n_good, n_wrong, s_good, s_wrong;
+  tally(n.disparity_px, cols / 2 + 20, cols - 20, &n_good, &n_wrong);
+  tally(s.disparity_px, cols / 2 + 20, cols - 20, &s_good, &s_wrong);
+  const int faint_pixels = (rows - 20) * (cols / 2 - 40);
+  INFO("faint half: narrow " << n_good << " good, " << n_wrong << " wrong; split " << s_good
+                             << " good, " << s_wrong << " wrong, of " << faint_pixels);
+  CHECK(s_good > 0.75 * faint_pixels);  // 0.83 (the narrow window: 0.47)
+  CHECK(s_good > 1.5 * n_good);
+  CHECK(s_wrong <= n_wrong);
+  // On the strong half, away from the faint one, every pixel is matched as
+  // with the narrow window alone.
+  for (int y = 0; y < rows; ++y)
+    for (int x = 0; x < cols / 2 - 30; ++x) {
+      const float a = n.disparity_px.at<float>(y, x), b = s.disparity_px.at<float>(y, x);
+      REQUIRE(((std::isnan(a) && std::isnan(b)) || a == b));
+    }
+}

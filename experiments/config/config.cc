@@ -322,6 +322,8 @@ void AddDdrParams(RunConfig* c, std::vector<ConfigParam>* params) {
           {&fp::kNl1WindowHalfPx, &f.nl1.window_half_px},
           {&fp::kNl1MinTextureDn, &f.nl1.min_texture_dn},
           {&fp::kNl1LrTolerancePx, &f.nl1.lr_tolerance_px},
+          {&fp::kNl1WeakWindowHalfPx, &f.nl1.weak_window_half_px},
+          {&fp::kNl1WeakTextureDn, &f.nl1.weak_texture_dn},
           {&fp::kNl1Cost, &f.nl1.cost},
           {&fp::kSgbmBlockSize, &f.sgbm.block_size},
           {&fp::kSgbmUniquenessRatio, &f.sgbm.uniqueness_ratio},

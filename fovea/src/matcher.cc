@@ -15,6 +15,8 @@ void Nl1Options::Check() const {
   rig::CheckParam(params::kNl1WindowHalfPx, window_half_px);
   rig::CheckParam(params::kNl1MinTextureDn, min_texture_dn);
   rig::CheckParam(params::kNl1LrTolerancePx, lr_tolerance_px);
+  rig::CheckParam(params::kNl1WeakWindowHalfPx, weak_window_half_px);
+  rig::CheckParam(params::kNl1WeakTextureDn, weak_texture_dn);
   rig::CheckParam(params::kNl1Cost, cost);
 }
 
@@ -722,6 +724,35 @@ void MatchRow(const Bands& bands, int y, double lr_tolerance_px, const RowWinner
   }
 }
 
+// The searched pixels (lo <= hi): their bounding box, inclusive (x1 < 0:
+// none), and the union of their bands.
+struct Searched {
+  int x0, x1, y0, y1;
+  float dlo, dhi;
+};
+Searched FindSearched(const cv::Mat& lo_px, const cv::Mat& hi_px) {
+  Searched s{lo_px.cols,
+             -1,
+             lo_px.rows,
+             -1,
+             std::numeric_limits<float>::infinity(),
+             -std::numeric_limits<float>::infinity()};
+  for (int y = 0; y < lo_px.rows; ++y) {
+    const float* lo = lo_px.ptr<float>(y);
+    const float* hi = hi_px.ptr<float>(y);
+    for (int x = 0; x < lo_px.cols; ++x)
+      if (lo[x] <= hi[x]) {
+        s.x0 = std::min(s.x0, x);
+        s.x1 = std::max(s.x1, x);
+        s.y0 = std::min(s.y0, y);
+        s.y1 = std::max(s.y1, y);
+        s.dlo = std::min(s.dlo, lo[x]);
+        s.dhi = std::max(s.dhi, hi[x]);
+      }
+  }
+  return s;
+}
+
 }  // namespace
 
 DisparityMap Nl1Matcher::Match(const cv::Mat& left, const cv::Mat& right, const cv::Mat& lo_px,
@@ -729,25 +760,75 @@ DisparityMap Nl1Matcher::Match(const cv::Mat& left, const cv::Mat& right, const 
   CV_Assert(left.type() == CV_8UC1 && right.type() == CV_8UC1 && left.size() == right.size());
   CV_Assert(lo_px.type() == CV_32F && hi_px.type() == CV_32F && lo_px.size() == left.size() &&
             hi_px.size() == left.size());
+  const int h = options_.window_half_px, hw = options_.weak_window_half_px;
+  if (hw <= h || options_.weak_texture_dn <= 0 || left.rows <= 2 * hw || left.cols <= 2 * hw)
+    return MatchOneWindow(options_, left, right, lo_px, hi_px);
+  // Split the searched pixels by the wide window's standard deviation
+  // (from box sums of I and I^2, O(1) per pixel, over the searched pixels'
+  // bounding box): faint ones, whose wide window lies in the image, take the
+  // wide window, the rest the narrow one.
+  const Searched searched = FindSearched(lo_px, hi_px);
+  const int x0 = std::max(searched.x0, hw), y0 = std::max(searched.y0, hw);
+  const int x1 = std::min(searched.x1, left.cols - hw - 1),
+            y1 = std::min(searched.y1, left.rows - hw - 1);
+  cv::Mat narrow_lo = lo_px.clone(), wide_lo = lo_px.clone();
+  const float none = std::numeric_limits<float>::infinity();
+  wide_lo.setTo(none);
+  if (x0 <= x1 && y0 <= y1) {
+    // The box with its windows' margin: the filters' borders never reach a
+    // pixel that is judged.
+    const cv::Rect box(x0 - hw, y0 - hw, x1 - x0 + 2 * hw + 1, y1 - y0 + 2 * hw + 1);
+    const int nw = 2 * hw + 1;
+    cv::Mat image, mean, mean_sq;
+    left(box).convertTo(image, CV_32F);
+    cv::boxFilter(image, mean, CV_32F, cv::Size(nw, nw));
+    cv::sqrBoxFilter(image, mean_sq, CV_32F, cv::Size(nw, nw));
+    const float max_var = static_cast<float>(options_.weak_texture_dn * options_.weak_texture_dn);
+    for (int y = y0; y <= y1; ++y) {
+      const float* m = mean.ptr<float>(y - box.y);
+      const float* m2 = mean_sq.ptr<float>(y - box.y);
+      const float* lo = lo_px.ptr<float>(y);
+      float* nlo = narrow_lo.ptr<float>(y);
+      float* wlo = wide_lo.ptr<float>(y);
+      for (int x = x0; x <= x1; ++x)
+        if (m2[x - box.x] - m[x - box.x] * m[x - box.x] < max_var) {
+          wlo[x] = lo[x];
+          nlo[x] = none;
+        }
+    }
+  }
+  Nl1Options wide = options_;
+  wide.window_half_px = hw;
+  DisparityMap out = MatchOneWindow(options_, left, right, narrow_lo, hi_px);
+  const DisparityMap w = MatchOneWindow(wide, left, right, wide_lo, hi_px);
+  for (int y = 0; y < left.rows; ++y) {
+    const float* wd = w.disparity_px.ptr<float>(y);
+    const float* wc = w.confidence.ptr<float>(y);
+    const float* wlo = wide_lo.ptr<float>(y);
+    float* d = out.disparity_px.ptr<float>(y);
+    float* c = out.confidence.ptr<float>(y);
+    for (int x = 0; x < left.cols; ++x)
+      if (wlo[x] != none) {
+        d[x] = wd[x];
+        c[x] = wc[x];
+      }
+  }
+  out.searched += w.searched;
+  out.matched += w.matched;
+  out.rejected_texture += w.rejected_texture;
+  out.rejected_lr += w.rejected_lr;
+  out.rejected_edge += w.rejected_edge;
+  return out;
+}
+
+DisparityMap Nl1Matcher::MatchOneWindow(const Nl1Options& options, const cv::Mat& left,
+                                        const cv::Mat& right, const cv::Mat& lo_px,
+                                        const cv::Mat& hi_px) {
   // Only the rectangle the searched pixels need is matched (a level's
   // fovea is a small part of its image): their bounding box and windows,
   // and on the right the columns their bands reach.
-  const int h = options_.window_half_px;
-  int x0 = left.cols, x1 = -1, y0 = left.rows, y1 = -1;
-  float dlo = std::numeric_limits<float>::infinity(), dhi = -dlo;
-  for (int y = 0; y < left.rows; ++y) {
-    const float* lo = lo_px.ptr<float>(y);
-    const float* hi = hi_px.ptr<float>(y);
-    for (int x = 0; x < left.cols; ++x)
-      if (lo[x] <= hi[x]) {
-        x0 = std::min(x0, x);
-        x1 = std::max(x1, x);
-        y0 = std::min(y0, y);
-        y1 = std::max(y1, y);
-        dlo = std::min(dlo, lo[x]);
-        dhi = std::max(dhi, hi[x]);
-      }
-  }
+  const int h = options.window_half_px;
+  const auto [x0, x1, y0, y1, dlo, dhi] = FindSearched(lo_px, hi_px);
   DisparityMap out;
   out.disparity_px = cv::Mat(left.size(), CV_32F, cv::Scalar(std::nanf("")));
   out.confidence = cv::Mat(left.size(), CV_32F, cv::Scalar(0));
@@ -762,21 +843,21 @@ DisparityMap Nl1Matcher::Match(const cv::Mat& left, const cv::Mat& right, const 
   DisparityMap part;  // views of `out`'s maps: the crop writes into them
   part.disparity_px = out.disparity_px(crop);
   part.confidence = out.confidence(crop);
-  MatchCrop(left(crop), right(crop), lo_px(crop), hi_px(crop), &part);
+  MatchCrop(options, left(crop), right(crop), lo_px(crop), hi_px(crop), &part);
   part.disparity_px = out.disparity_px;
   part.confidence = out.confidence;
   return part;
 }
 
-void Nl1Matcher::MatchCrop(const cv::Mat& left, const cv::Mat& right, const cv::Mat& lo_px,
-                           const cv::Mat& hi_px, DisparityMap* result) const {
-  const int h = options_.window_half_px, n = 2 * h + 1;
+void Nl1Matcher::MatchCrop(const Nl1Options& options, const cv::Mat& left, const cv::Mat& right,
+                           const cv::Mat& lo_px, const cv::Mat& hi_px, DisparityMap* result) {
+  const int h = options.window_half_px, n = 2 * h + 1;
   DisparityMap& out = *result;
   if (left.rows < n || left.cols < n) return;
   cv::Mat ml;  // the left window means, for the texture test
   cv::boxFilter(left, ml, CV_32F, cv::Size(n, n));
-  const bool prenormalized = options_.cost == "prenormalized";
-  const bool zero_mean_ssd = options_.cost == "zero_mean_ssd";
+  const bool prenormalized = options.cost == "prenormalized";
+  const bool zero_mean_ssd = options.cost == "zero_mean_ssd";
   cv::Mat image, sl, sr, a, b;
   left.convertTo(image, CV_32F);
   if (zero_mean_ssd) {
@@ -800,7 +881,7 @@ void Nl1Matcher::MatchCrop(const cv::Mat& left, const cv::Mat& right, const cv::
               cv::Mat(left.size(), CV_32S, cv::Scalar(0))};
   // Strips of rows are independent, but matching them on OpenCV's thread
   // pool did not pay on the 2-core machine (the README's figures): serial.
-  SearchBands(image, ml, lo_px, hi_px, options_, h, left.rows - h, &bands, &out);
+  SearchBands(image, ml, lo_px, hi_px, options, h, left.rows - h, &bands, &out);
   CostVolume v;
   RowWinners w(left.cols);
   for (int y0 = h; y0 < left.rows - h; y0 += kStripRows) {
@@ -814,7 +895,7 @@ void Nl1Matcher::MatchCrop(const cv::Mat& left, const cv::Mat& right, const cv::
       FillWindowMean(left, right, sl, sr, h, &v);
     for (int y = y0; y < y1; ++y) {
       w.Find(v, bands, y);
-      MatchRow(bands, y, options_.lr_tolerance_px, &w, &out);
+      MatchRow(bands, y, options.lr_tolerance_px, &w, &out);
     }
   }
 }

@@ -29,6 +29,17 @@ struct Nl1Options {
   int window_half_px = 3;        ///< a 7 x 7 window
   double min_texture_dn = 2.0;   ///< mean absolute deviation of the left window
   double lr_tolerance_px = 1.0;  ///< left-right check
+  /// Beyond the paper: a pixel whose window of this half width has a faint
+  /// texture (standard deviation below weak_texture_dn) is matched with that
+  /// wider window instead of window_half_px's, and every other pixel with
+  /// the narrow one. On a faint texture the sensor's noise swamps a 7 x 7
+  /// window; a wide window that holds a strong edge or texture anywhere is
+  /// not faint, so the wide windows never reach across such an edge. Off by
+  /// default: over the accuracy benchmark it mapped the faint surfaces but
+  /// more wrong pixels too (README, "The map's trust"). 0, or not wider than
+  /// window_half_px: one window everywhere, the paper's.
+  int weak_window_half_px = 0;
+  double weak_texture_dn = 0;
   /// "window_mean" (the paper's) or "prenormalized" (params::kNl1Cost).
   std::string cost = "window_mean";
   void Check() const;  ///< throws rig::InputError naming the key (fovea/params.h)
@@ -58,8 +69,12 @@ class Nl1Matcher : public StereoMatcher {
   /// Match on a crop that holds every searched pixel with its window and
   /// the right columns its band reaches; writes into `out`'s maps (views of
   /// the crop, initialized) and counts into its counters.
-  void MatchCrop(const cv::Mat& left, const cv::Mat& right, const cv::Mat& lo_px,
-                 const cv::Mat& hi_px, DisparityMap* out) const;
+  static void MatchCrop(const Nl1Options& options, const cv::Mat& left, const cv::Mat& right,
+                        const cv::Mat& lo_px, const cv::Mat& hi_px, DisparityMap* out);
+  /// Match() with one window size, `options`'.
+  static DisparityMap MatchOneWindow(const Nl1Options& options, const cv::Mat& left,
+                                     const cv::Mat& right, const cv::Mat& lo_px,
+                                     const cv::Mat& hi_px);
   Nl1Options options_;
 };
 

@@ -267,6 +267,16 @@ inline constexpr ParamSpec kNl1WindowHalfPx{
 inline constexpr ParamSpec kNl1MinTextureDn{
     "nl1.min_texture_dn", "NL1: a left window needs this mean absolute deviation, grey levels", 0,
     50};
+inline constexpr ParamSpec kNl1WeakWindowHalfPx{
+    "nl1.weak_window_half_px",
+    "beyond the paper: NL1 matches a pixel whose window of this half width has a faint texture "
+    "(nl1.weak_texture_dn) with that wider window instead (0 = one window everywhere); h, pixels",
+    0, 20};
+inline constexpr ParamSpec kNl1WeakTextureDn{
+    "nl1.weak_texture_dn",
+    "see nl1.weak_window_half_px: a texture is faint where the wider window's standard deviation "
+    "is below this, grey levels",
+    0, 50};
 inline constexpr ParamSpec kNl1LrTolerancePx{"nl1.lr_tolerance_px",
                                              "NL1: left-right check tolerance, pixels", 0.01, 10};
 inline constexpr const char* kNl1Costs[] = {"window_mean", "prenormalized", "zero_mean_ssd",
