@@ -243,7 +243,11 @@ Reference MatchPlainly(const cv::Mat& left, const cv::Mat& right, const cv::Mat&
 }  // namespace
 
 TEST_CASE("the cost-volume matcher gives what its rules give, pixel by pixel", "[fovea][matcher]") {
-  const cv::Mat left = Texture(72, 150, 21);
+  // 300 rows: over 32768 pixels to match, which the matcher splits between
+  // two threads.
+  const int rows = GENERATE(72, 300);
+  INFO("rows " << rows);
+  const cv::Mat left = Texture(rows, 150, 21);
   // A disparity that grows across the image (a slanted surface), and bands
   // that vary per pixel: narrow about a map's prediction, wide where it is
   // silent, absurd where a ray grazes the right camera, none here and there,

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <future>
 #include <limits>
 #include <opencv2/imgproc.hpp>
 #include <vector>
@@ -38,6 +39,9 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 // The level is matched in strips of this many rows; each disparity's costs
 // span only the columns some pixel of the strip needs them at.
 constexpr int kStripRows = 16;
+// Crops with at least this many pixels to match (past the texture test)
+// are matched on two threads (Nl1Matcher::MatchCrop).
+constexpr int kThreadedMinPixels = 8192;
 // Within a row, the columns are grouped in chunks of this many (chunk k:
 // [k * kChunkCols, (k + 1) * kChunkCols) of the matched crop), the block of
 // columns the paper's cost sums in registers (FillWindowMean).
@@ -879,25 +883,45 @@ void Nl1Matcher::MatchCrop(const Nl1Options& options, const cv::Mat& left, const
   }
   Bands bands{cv::Mat(left.size(), CV_32S, cv::Scalar(1)),
               cv::Mat(left.size(), CV_32S, cv::Scalar(0))};
-  // Strips of rows are independent, but matching them on OpenCV's thread
-  // pool did not pay on the 2-core machine (the README's figures): serial.
   SearchBands(image, ml, lo_px, hi_px, options, h, left.rows - h, &bands, &out);
-  CostVolume v;
-  RowWinners w(left.cols);
-  for (int y0 = h; y0 < left.rows - h; y0 += kStripRows) {
-    const int y1 = std::min(y0 + kStripRows, left.rows - h);
-    if (!SizeVolume(bands, y0, y1, h, &v)) continue;
-    if (prenormalized)
-      FillPrenormalized(a, b, h, &v);
-    else if (zero_mean_ssd)
-      FillZeroMeanSsd(left, right, h, &v);
-    else
-      FillWindowMean(left, right, sl, sr, h, &v);
-    for (int y = y0; y < y1; ++y) {
-      w.Find(v, bands, y);
-      MatchRow(bands, y, options.lr_tolerance_px, &w, &out);
+  // Strips of rows are independent: every other strip from `first` on,
+  // each with its own cost volume, into `o` (rows apart from the other
+  // half's, in the same maps).
+  auto match_strips = [&](int first, DisparityMap* o) {
+    CostVolume v;
+    RowWinners w(left.cols);
+    for (int y0 = h + first * kStripRows; y0 < left.rows - h; y0 += 2 * kStripRows) {
+      const int y1 = std::min(y0 + kStripRows, left.rows - h);
+      if (!SizeVolume(bands, y0, y1, h, &v)) continue;
+      if (prenormalized)
+        FillPrenormalized(a, b, h, &v);
+      else if (zero_mean_ssd)
+        FillZeroMeanSsd(left, right, h, &v);
+      else
+        FillWindowMean(left, right, sl, sr, h, &v);
+      for (int y = y0; y < y1; ++y) {
+        w.Find(v, bands, y);
+        MatchRow(bands, y, options.lr_tolerance_px, &w, o);
+      }
     }
-  }
+  };
+  // A large crop (a full-resolution periphery) is matched on two threads,
+  // the machine's two cores: half its strips each, interleaved so that
+  // both get a like share of the bands. A fovea's crop is too small to pay
+  // for a thread. The same result either way.
+  DisparityMap odd;  // the second thread's counts; its maps are `out`'s
+  odd.disparity_px = out.disparity_px;
+  odd.confidence = out.confidence;
+  std::future<void> other;
+  if (out.searched - out.rejected_texture >= kThreadedMinPixels)
+    other = std::async(std::launch::async, match_strips, 1, &odd);
+  else
+    match_strips(1, &out);
+  match_strips(0, &out);
+  if (other.valid()) other.get();
+  out.matched += odd.matched;
+  out.rejected_lr += odd.rejected_lr;
+  out.rejected_edge += odd.rejected_edge;
 }
 
 }  // namespace fovea
