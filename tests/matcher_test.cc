@@ -243,8 +243,8 @@ Reference MatchPlainly(const cv::Mat& left, const cv::Mat& right, const cv::Mat&
 }  // namespace
 
 TEST_CASE("the cost-volume matcher gives what its rules give, pixel by pixel", "[fovea][matcher]") {
-  // 300 rows: over 32768 pixels to match, which the matcher splits between
-  // two threads.
+  // 300 rows: several times the pixels to match at which the matcher
+  // splits a crop between two threads (8192).
   const int rows = GENERATE(72, 300);
   INFO("rows " << rows);
   const cv::Mat left = Texture(rows, 150, 21);

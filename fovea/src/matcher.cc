@@ -728,6 +728,15 @@ void MatchRow(const Bands& bands, int y, double lr_tolerance_px, const RowWinner
   }
 }
 
+// Adds `from`'s counts to `to`'s.
+void AddCounts(const DisparityMap& from, DisparityMap* to) {
+  to->searched += from.searched;
+  to->matched += from.matched;
+  to->rejected_texture += from.rejected_texture;
+  to->rejected_lr += from.rejected_lr;
+  to->rejected_edge += from.rejected_edge;
+}
+
 // The searched pixels (lo <= hi): their bounding box, inclusive (x1 < 0:
 // none), and the union of their bands.
 struct Searched {
@@ -805,23 +814,20 @@ DisparityMap Nl1Matcher::Match(const cv::Mat& left, const cv::Mat& right, const 
   wide.window_half_px = hw;
   DisparityMap out = MatchOneWindow(options_, left, right, narrow_lo, hi_px);
   const DisparityMap w = MatchOneWindow(wide, left, right, wide_lo, hi_px);
-  for (int y = 0; y < left.rows; ++y) {
+  // The faint pixels lie in the box [x0, x1] x [y0, y1] (none if it is empty).
+  for (int y = y0; y <= y1; ++y) {
     const float* wd = w.disparity_px.ptr<float>(y);
     const float* wc = w.confidence.ptr<float>(y);
     const float* wlo = wide_lo.ptr<float>(y);
     float* d = out.disparity_px.ptr<float>(y);
     float* c = out.confidence.ptr<float>(y);
-    for (int x = 0; x < left.cols; ++x)
+    for (int x = x0; x <= x1; ++x)
       if (wlo[x] != none) {
         d[x] = wd[x];
         c[x] = wc[x];
       }
   }
-  out.searched += w.searched;
-  out.matched += w.matched;
-  out.rejected_texture += w.rejected_texture;
-  out.rejected_lr += w.rejected_lr;
-  out.rejected_edge += w.rejected_edge;
+  AddCounts(w, &out);
   return out;
 }
 
@@ -919,9 +925,7 @@ void Nl1Matcher::MatchCrop(const Nl1Options& options, const cv::Mat& left, const
     match_strips(1, &out);
   match_strips(0, &out);
   if (other.valid()) other.get();
-  out.matched += odd.matched;
-  out.rejected_lr += odd.rejected_lr;
-  out.rejected_edge += odd.rejected_edge;
+  AddCounts(odd, &out);
 }
 
 }  // namespace fovea
