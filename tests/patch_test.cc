@@ -157,6 +157,60 @@ TEST_CASE("patch map: rendering into a view gives depth and patch ids", "[fovea]
     }
 }
 
+TEST_CASE("patch map: a render draws exactly the pixels inside a patch's projection",
+          "[fovea][patch]") {
+  // Rotated, slanted, thin and partly outside the image: each pixel centre
+  // well inside either triangle of the projected quad is drawn, and none
+  // well outside (Render only tests the columns of each row about a
+  // triangle's span).
+  const auto k = rig::CameraIntrinsics::FromHorizontalFov(160, 120, 1.0);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int inside = 0, wrong = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const Eigen::Vector3d centre(0.6 * u(rng), 0.45 * u(rng), 1.5 + 0.4 * u(rng));
+    const double angle = M_PI * u(rng), w = 0.2 * (1.05 + u(rng)), h = 0.2 * (1.05 + u(rng));
+    const Eigen::Vector3d a(std::cos(angle), std::sin(angle), 0.3 * u(rng));
+    const Eigen::Vector3d b(-std::sin(angle), std::cos(angle), 0.3 * u(rng));
+    fovea::Patch p;
+    p.corners_W = {centre - w * a - h * b, centre + w * a - h * b, centre + w * a + h * b,
+                   centre - w * a + h * b};
+    fovea::PatchMap map;
+    map.Add(p);
+    cv::Mat depth, ids;
+    map.Render(Eigen::Isometry3d::Identity(), k, &depth, &ids);
+    Eigen::Vector2d q[4];
+    for (int c = 0; c < 4; ++c) q[c] = k.Project(p.corners_W[c]);
+    // Signed distance in pixels of (x, y) inside triangle (i, j, l): the
+    // least over its edges, positive inside.
+    auto margin = [&](int i, int j, int l, double x, double y) {
+      const Eigen::Vector2d t[3] = {q[i], q[j], q[l]};
+      const double area =
+          (t[1] - t[0]).x() * (t[2] - t[0]).y() - (t[1] - t[0]).y() * (t[2] - t[0]).x();
+      double least = 1e300;
+      for (int e = 0; e < 3; ++e) {
+        const Eigen::Vector2d &s = t[e], &f = t[(e + 1) % 3];
+        const double cross = (f - s).x() * (y - s.y()) - (f - s).y() * (x - s.x());
+        least = std::min(least, (area > 0 ? cross : -cross) / (f - s).norm());
+      }
+      return least;
+    };
+    for (int y = 0; y < k.height_px; ++y)
+      for (int x = 0; x < k.width_px; ++x) {
+        const double m = std::max(margin(0, 1, 2, x, y), margin(0, 2, 3, x, y));
+        const bool drawn = ids.at<int>(y, x) == 0;
+        if (m > 1e-3) {
+          ++inside;
+          wrong += !drawn;
+        } else if (m < -1e-3) {
+          wrong += drawn;
+        }
+      }
+  }
+  CHECK(inside > 10000);
+  CHECK(wrong == 0);
+}
+
 TEST_CASE("patch map: a render of a region equals the whole render there, empty elsewhere",
           "[fovea][patch]") {
   fovea::PatchMap map;

@@ -338,13 +338,20 @@ int ErodeAtDisparityJumps(int radius, double jump_px, cv::Mat* disparity) {
   // Only the matched pixels' bounding box and `radius` around it can change
   // (elsewhere the limit is +inf, as beyond the image's border): the fovea's
   // level is mostly unmatched.
-  cv::Rect box;
+  int x0 = disparity->cols, x1 = -1, y0 = disparity->rows, y1 = -1;
   for (int y = 0; y < disparity->rows; ++y) {
     const float* row = disparity->ptr<float>(y);
-    for (int x = 0; x < disparity->cols; ++x)
-      if (std::isfinite(row[x])) box |= cv::Rect(x, y, 1, 1);
+    int first = 0, last = disparity->cols - 1;
+    while (first <= last && !std::isfinite(row[first])) ++first;
+    while (last > first && !std::isfinite(row[last])) --last;
+    if (first > last) continue;
+    x0 = std::min(x0, first);
+    x1 = std::max(x1, last);
+    y0 = std::min(y0, y);
+    y1 = y;
   }
-  if (box.empty()) return 0;
+  if (x1 < 0) return 0;
+  cv::Rect box(x0, y0, x1 - x0 + 1, y1 - y0 + 1);
   box = cv::Rect(box.x - radius, box.y - radius, box.width + 2 * radius, box.height + 2 * radius) &
         cv::Rect(0, 0, disparity->cols, disparity->rows);
   cv::Mat d = (*disparity)(box);
@@ -354,16 +361,24 @@ int ErodeAtDisparityJumps(int radius, double jump_px, cv::Mat* disparity) {
   // good matches around it.
   constexpr int kSupport = 3;
   cv::Mat farthest(d.size(), CV_32F, cv::Scalar(std::numeric_limits<float>::infinity()));
-  for (int y = 0; y < d.rows; ++y)
+  for (int y = 0; y < d.rows; ++y) {
+    // The rows above and below (none beyond the box: there the image ends or
+    // nothing is matched).
+    const float* rows[3] = {y > 0 ? d.ptr<float>(y - 1) : nullptr, d.ptr<float>(y),
+                            y + 1 < d.rows ? d.ptr<float>(y + 1) : nullptr};
+    float* out = farthest.ptr<float>(y);
     for (int x = 0; x < d.cols; ++x) {
-      const float here = d.at<float>(y, x);
+      const float here = rows[1][x];
       if (!std::isfinite(here)) continue;
+      const int u0 = std::max(0, x - 1), u1 = std::min(d.cols - 1, x + 1);
       int support = 0;
-      for (int v = std::max(0, y - 1); v <= std::min(d.rows - 1, y + 1); ++v)
-        for (int u = std::max(0, x - 1); u <= std::min(d.cols - 1, x + 1); ++u)
-          support += (u != x || v != y) && std::abs(d.at<float>(v, u) - here) <= jump_px;
-      if (support >= kSupport) farthest.at<float>(y, x) = here;
+      for (const float* row : rows)
+        if (row)
+          for (int u = u0; u <= u1; ++u)
+            support += (u != x || row != rows[1]) && std::abs(row[u] - here) <= jump_px;
+      if (support >= kSupport) out[x] = here;
     }
+  }
   cv::erode(farthest, farthest,
             cv::getStructuringElement(cv::MORPH_RECT, {2 * radius + 1, 2 * radius + 1}));
   int n = 0;

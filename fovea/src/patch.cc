@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <future>
 #include <limits>
 
 namespace fovea {
@@ -87,13 +88,17 @@ std::optional<PlaneFit> FitDisparityPlane(const std::vector<DisparitySample>& sa
   std::vector<const DisparitySample*> inliers = in_block;
   PlaneFit fit;
   for (int round = 0; round < 3; ++round) {
-    Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d atb = Eigen::Vector3d::Zero();
+    // The normal equations' sums, in registers: the products and their order
+    // are those of accumulating row * row^T and row * d with Eigen.
+    double xx = 0, xy = 0, x1 = 0, yy = 0, y1 = 0, n = 0, xd = 0, yd = 0, d1 = 0;
     for (const DisparitySample* s : inliers) {
-      const Eigen::Vector3d row(s->x_px - cx, s->y_px - cy, 1);
-      ata += row * row.transpose();
-      atb += row * s->disparity_px;
+      const double x = s->x_px - cx, y = s->y_px - cy, d = s->disparity_px;
+      xx += x * x, xy += x * y, x1 += x, yy += y * y, y1 += y, n += 1;
+      xd += x * d, yd += y * d, d1 += d;
     }
+    Eigen::Matrix3d ata;
+    ata << xx, xy, x1, xy, yy, y1, x1, y1, n;
+    const Eigen::Vector3d atb(xd, yd, d1);
     // Degenerate support (all on one line): tiny smallest eigenvalue.
     const Eigen::Vector3d eig = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(ata).eigenvalues();
     if (eig.minCoeff() < 1e-6 * eig.maxCoeff()) return std::nullopt;
@@ -159,13 +164,16 @@ void FitBlock(const cv::Mat& disparity, const cv::Mat& unbounded, int bx, int by
   PlaneFitOptions o = options;
   o.min_support = std::min(options.min_support, (3 * size * size) / 4);
   std::vector<DisparitySample> samples;
-  for (int y = by; y < std::min(by + size, disparity.rows); ++y)
-    for (int x = bx; x < std::min(bx + size, disparity.cols); ++x) {
-      const float d = disparity.at<float>(y, x);
-      if (std::isfinite(d))
-        samples.push_back(
-            {double(x), double(y), d, unbounded.empty() || unbounded.at<uchar>(y, x) == 0});
-    }
+  samples.reserve(static_cast<size_t>(size) * size);
+  const bool all_bound = unbounded.empty();
+  const int x_end = std::min(bx + size, disparity.cols);
+  for (int y = by; y < std::min(by + size, disparity.rows); ++y) {
+    const float* row = disparity.ptr<float>(y);
+    const uchar* free_row = all_bound ? nullptr : unbounded.ptr<uchar>(y);
+    for (int x = bx; x < x_end; ++x)
+      if (std::isfinite(row[x]))
+        samples.push_back({double(x), double(y), row[x], all_bound || free_row[x] == 0});
+  }
   if (samples.empty()) return;
   Eigen::Vector4d box;
   Quad2d quad;
@@ -202,11 +210,26 @@ std::vector<BlockFit> FitBlocks(const cv::Mat& disparity, int size, const PlaneF
                                 const BlockOptions& blocks,
                                 const std::function<bool(int x, int y, int size)>& keep,
                                 const cv::Mat& unbounded) {
-  std::vector<BlockFit> out;
-  for (int by = 0; by + size <= disparity.rows; by += size)
-    for (int bx = 0; bx + size <= disparity.cols; bx += size)
-      if (!keep || keep(bx, by, size))
-        FitBlock(disparity, unbounded, bx, by, size, options, blocks, &out);
+  // Rows of blocks [first, end), in order.
+  auto fit_rows = [&](int first, int end, std::vector<BlockFit>* out) {
+    for (int row = first; row < end; ++row)
+      for (int bx = 0; bx + size <= disparity.cols; bx += size)
+        if (!keep || keep(bx, row * size, size))
+          FitBlock(disparity, unbounded, bx, row * size, size, options, blocks, out);
+  };
+  const int rows = disparity.rows / size;
+  std::vector<BlockFit> out, lower;
+  // A large level's block rows on two threads, the lower half's fits
+  // appended after the upper's: the same fits in the same order.
+  constexpr int kThreadedMinBlocks = 256;
+  if (rows < 2 || rows * (disparity.cols / size) < kThreadedMinBlocks) {
+    fit_rows(0, rows, &out);
+    return out;
+  }
+  auto other = std::async(std::launch::async, fit_rows, rows / 2, rows, &lower);
+  fit_rows(0, rows / 2, &out);
+  other.get();
+  out.insert(out.end(), lower.begin(), lower.end());
   return out;
 }
 
@@ -441,13 +464,30 @@ void PatchMap::Render(const Eigen::Isometry3d& world_T_camera, const rig::Camera
       const int v1 =
           std::min(drawn.y + drawn.height - 1,
                    static_cast<int>(std::floor(std::max({uv[0].y(), uv[1].y(), uv[2].y()}))));
+      auto edge = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
+        return (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+      };
       for (int v = v0; v <= v1; ++v) {
-        for (int u = u0; u <= u1; ++u) {
+        // The row's columns inside the triangle, with a pixel to spare
+        // either side: only they are tested below, which decides. Inside,
+        // each edge function times the area is at least -1e-9 area^2 (the
+        // test's tolerance), affine along the row: slope * u + offset,
+        // with a far wider tolerance here so that no rounding excludes a
+        // column the test would take.
+        double lo = u0 - 1, hi = u1 + 1;
+        const double tolerance = 1e-6 * (area * area + 1);
+        for (int e = 0; e < 3; ++e) {
+          const Eigen::Vector2d &a = uv[(e + 1) % 3], &b = uv[(e + 2) % 3];
+          const double slope = -(b - a).y() * area,
+                       offset =
+                           ((b - a).x() * (v - a.y()) + (b - a).y() * a.x()) * area + tolerance;
+          if (slope > 0) lo = std::max(lo, -offset / slope);
+          if (slope < 0) hi = std::min(hi, -offset / slope);
+        }
+        const int first = std::max(u0, static_cast<int>(std::floor(std::max(lo, u0 - 1.0))) - 1);
+        const int last = std::min(u1, static_cast<int>(std::ceil(std::min(hi, u1 + 1.0))) + 1);
+        for (int u = first; u <= last; ++u) {
           const Eigen::Vector2d p(u, v);
-          auto edge = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b,
-                         const Eigen::Vector2d& c) {
-            return (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
-          };
           const double w0 = edge(uv[1], uv[2], p) / area, w1 = edge(uv[2], uv[0], p) / area;
           const double w2 = 1 - w0 - w1;
           if (w0 < -1e-9 || w1 < -1e-9 || w2 < -1e-9) continue;

@@ -5,6 +5,7 @@
 #include <bitset>
 #include <cmath>
 #include <cstdint>
+#include <future>
 #include <optional>
 
 #include "fovea/geometry.h"
@@ -72,48 +73,61 @@ std::vector<std::uint8_t> HiddenQuarters(const PatchMap& patches, const rig::Cam
   const Eigen::Isometry3d m_T_w = measured.world_T_camera.inverse();
   const Eigen::Isometry3d r_T_w = reference.world_T_camera.inverse();
   const double min_var = options.min_texture_dn * options.min_texture_dn;
-  for (size_t i = 0; i < patches.size(); ++i) {
-    const Patch& patch = patches[i];
-    // Samples about a pixel apart in the measuring image.
-    double side_px = 0;
-    for (int k = 0; k < 4; ++k) {
-      const auto a = ProjectIntoCamera(m_T_w, measured.intrinsics, patch.corners_W[k]);
-      const auto b = ProjectIntoCamera(m_T_w, measured.intrinsics, patch.corners_W[(k + 1) % 4]);
-      if (a && b) side_px = std::max(side_px, (*a - *b).norm());
-    }
-    const int n = 2 * std::clamp(static_cast<int>(std::lround(side_px / 2)), 2, 16);
-    std::array<NccSums, 4> quarter;
-    std::array<int, 4> tried{0, 0, 0, 0};
-    for (int v = 0; v < n; ++v)
-      for (int u = 0; u < n; ++u) {
-        const Eigen::Vector3d x = QuadPoint(patch, (u + 0.5) / n, (v + 0.5) / n);
-        const int q = (v >= n / 2) * 2 + (u >= n / 2);
-        ++tried[q];
-        const auto pm = ProjectIntoCamera(m_T_w, measured.intrinsics, x);
-        const auto pr = ProjectIntoCamera(r_T_w, reference.intrinsics, x);
-        if (!pm || !pr) continue;
-        const auto gm = SampleGray(measured.gray, *pm), gr = SampleGray(reference.gray, *pr);
-        if (gm && gr) quarter[q].Add(*gm, *gr);
+  // Each patch is judged alone: the patches are split between two threads,
+  // each writing its own entries (the result does not depend on the split).
+  auto judge = [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      const Patch& patch = patches[i];
+      // Samples about a pixel apart in the measuring image.
+      double side_px = 0;
+      for (int k = 0; k < 4; ++k) {
+        const auto a = ProjectIntoCamera(m_T_w, measured.intrinsics, patch.corners_W[k]);
+        const auto b = ProjectIntoCamera(m_T_w, measured.intrinsics, patch.corners_W[(k + 1) % 4]);
+        if (a && b) side_px = std::max(side_px, (*a - *b).norm());
       }
-    for (int q = 0; q < 4; ++q)
-      if (quarter[q].Uncorrelated(tried[q], min_var, options.min_ncc))
-        hidden[i] |= std::uint8_t(1u << q);
-    if (options.pooled_min_ncc <= 0) continue;
-    // The left and the right column of quarters, then the whole patch.
-    const double pooled_min_var = options.pooled_min_texture_dn * options.pooled_min_texture_dn;
-    for (const std::uint8_t group : {std::uint8_t{5}, std::uint8_t{10}, std::uint8_t{15}}) {
-      NccSums sums;
-      int tried_group = 0;
-      for (int q = 0; q < 4; ++q)
-        if (group & (1u << q)) {
-          sums += quarter[q];
-          tried_group += tried[q];
+      const int n = 2 * std::clamp(static_cast<int>(std::lround(side_px / 2)), 2, 16);
+      std::array<NccSums, 4> quarter;
+      std::array<int, 4> tried{0, 0, 0, 0};
+      for (int v = 0; v < n; ++v)
+        for (int u = 0; u < n; ++u) {
+          const Eigen::Vector3d x = QuadPoint(patch, (u + 0.5) / n, (v + 0.5) / n);
+          const int q = (v >= n / 2) * 2 + (u >= n / 2);
+          ++tried[q];
+          const auto pm = ProjectIntoCamera(m_T_w, measured.intrinsics, x);
+          const auto pr = ProjectIntoCamera(r_T_w, reference.intrinsics, x);
+          if (!pm || !pr) continue;
+          const auto gm = SampleGray(measured.gray, *pm), gr = SampleGray(reference.gray, *pr);
+          if (gm && gr) quarter[q].Add(*gm, *gr);
         }
-      if ((hidden[i] & group) != group &&
-          sums.Uncorrelated(tried_group, pooled_min_var, options.pooled_min_ncc,
-                            ReferenceCheckOptions::kMinPooledSamples))
-        hidden[i] |= group;
+      for (int q = 0; q < 4; ++q)
+        if (quarter[q].Uncorrelated(tried[q], min_var, options.min_ncc))
+          hidden[i] |= std::uint8_t(1u << q);
+      if (options.pooled_min_ncc <= 0) continue;
+      // The left and the right column of quarters, then the whole patch.
+      const double pooled_min_var = options.pooled_min_texture_dn * options.pooled_min_texture_dn;
+      for (const std::uint8_t group : {std::uint8_t{5}, std::uint8_t{10}, std::uint8_t{15}}) {
+        NccSums sums;
+        int tried_group = 0;
+        for (int q = 0; q < 4; ++q)
+          if (group & (1u << q)) {
+            sums += quarter[q];
+            tried_group += tried[q];
+          }
+        if ((hidden[i] & group) != group &&
+            sums.Uncorrelated(tried_group, pooled_min_var, options.pooled_min_ncc,
+                              ReferenceCheckOptions::kMinPooledSamples))
+          hidden[i] |= group;
+      }
     }
+  };
+  constexpr size_t kThreadedMinPatches = 64;
+  const size_t half = patches.size() / 2;
+  if (patches.size() < kThreadedMinPatches) {
+    judge(0, patches.size());
+  } else {
+    auto first = std::async(std::launch::async, judge, size_t{0}, half);
+    judge(half, patches.size());
+    first.get();
   }
   return hidden;
 }
