@@ -122,6 +122,50 @@ TEST_CASE("where the map is silent, a surface outside Z_T gives no false patches
   CHECK(ours_checked.second >= ours.second - ours.first);  // the right patches stay
 }
 
+TEST_CASE("a surface outside Z_T the map is silent on is searched about the wide match",
+          "[foveal][slow]") {
+  // Fixating the plywood at 1.2 m with nothing mapped, at the run's
+  // defaults but for the baseline: the wooden blocks at 0.50-0.56 m lie far
+  // outside Z_T. The band's matches there are dropped by the wide search;
+  // with foveal.silent_outside_seed the blocks are searched about its match
+  // and mapped, right.
+  sim::SimRigConfig config;
+  config.noise.read_noise_sigma_dn = experiments::kExperimentNoiseSigmaDn;
+  struct Figures {
+    int near = 0, near_gross = 0;
+  };
+  auto fixate = [&](bool seed) {
+    auto sim = scenes::LoadScene("three_surfaces", config);
+    fovea::FixationOptions o = fovea::ResolvedFixationOptions({});  // the run's
+    o.baseline_m = 0.12;  // Z_T about -0.15 / +0.2 m around 1.2 m
+    o.mapped_baseline_m = 0;
+    o.foveal.silent_near_m = 0.4;  // as the run sets it (idr.z_min_m)
+    o.foveal.silent_outside_seed = seed;
+    const fovea::Nl1Matcher matcher;
+    const Eigen::Vector3d plywood(-0.25, 1.2, 0.1);
+    const fovea::FixationResult r =
+        fovea::Fixate(sim->rig(), fovea::PatchMap(), plywood, matcher, o);
+    REQUIRE(r.ok);
+    const Eigen::Vector3d eye = r.servo.frame.left.world_T_camera.translation();
+    Figures f;
+    for (const fovea::Patch& p : r.foveal.patches.patches()) {
+      const Eigen::Vector3d ray = p.Centre() - eye;
+      if (ray.norm() > 0.8) continue;  // the plywood's, and the band's
+      const auto hit = sim->truth().CastRay(eye, ray);
+      ++f.near;
+      f.near_gross += !hit || std::abs(hit->distance_m - ray.norm()) > 0.05 * ray.norm();
+    }
+    return f;
+  };
+  const Figures band = fixate(false), seeded = fixate(true);
+  INFO("patches nearer than 0.8 m: band " << band.near << " (" << band.near_gross
+                                          << " off by over 5%), seeded " << seeded.near << " ("
+                                          << seeded.near_gross << ")");
+  CHECK(band.near <= 2);
+  CHECK(seeded.near >= 20);
+  CHECK(seeded.near_gross * 10 <= seeded.near);
+}
+
 TEST_CASE("peripheral blocks are not split below the matching window beside depth edges",
           "[foveal][slow]") {
   // A fixation on the near wooden block's face: its edges against the

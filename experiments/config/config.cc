@@ -307,6 +307,7 @@ void AddFovealParams(RunConfig* c, std::vector<ConfigParam>* params) {
                      {&fp::kFovealSilentConfidence, &x.foveal.silent_confidence},
                      {&fp::kFovealRectifiedSilentConfidence, &x.foveal.rectified_silent_confidence},
                      {&fp::kFovealSilentCheckLevel, &x.foveal.silent_check_level},
+                     {&fp::kFovealSilentOutsideSeed, &x.foveal.silent_outside_seed},
                      {&fp::kFovealServoMaxSteps, &x.servo.max_steps},
                  });
 }

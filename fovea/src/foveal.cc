@@ -205,6 +205,34 @@ Inner FinerLevel(const Tessellation& t, int index) {
   return {index > 0 ? t.rects[index - 1] : cv::Rect(), cv::Mat()};
 }
 
+// The wide search behind FovealOptions::silent_near_m, once per fixation
+// at one coarse resolution (2^silent_check_level full-resolution pixels
+// per pixel): every pixel the map is silent at, over every depth from
+// silent_near_m to infinity and the Z_T band.
+struct SilentCheck {
+  double scale = 1;  ///< full-resolution pixels per pixel
+  cv::Mat wide;      ///< disparity, its pixels (NaN: none); empty: no check
+  cv::Mat confidence;
+  /// CV_8U, non-zero where the match and its 8 neighbours' lie within one
+  /// of its pixels of one another: no depth edge about it.
+  cv::Mat smooth;
+  /// The wide search's match about pixel (x, y) of a level of `level_scale`
+  /// full-resolution pixels per pixel: its disparity in that level's pixels
+  /// (NaN: none, or no search), its confidence, and whether it is smooth.
+  struct Match {
+    double disparity, confidence;
+    bool smooth;
+  };
+  Match At(int x, int y, double level_scale) const {
+    if (wide.empty()) return {std::nan(""), 0, false};
+    const double ratio = scale / level_scale;  // level pixels per check pixel
+    const int xc = std::min(wide.cols - 1, static_cast<int>((x + 0.5) / ratio));
+    const int yc = std::min(wide.rows - 1, static_cast<int>((y + 0.5) / ratio));
+    return {wide.at<float>(yc, xc) * ratio, confidence.at<float>(yc, xc),
+            smooth.at<uchar>(yc, xc) != 0};
+  }
+};
+
 // Per-pixel disparity ranges of one level (lo > hi: not searched): around the
 // coarser level's estimate, else around the map's prediction, else (the map
 // silent) the Z_T band about the fixation depth, marked in `silent`.
@@ -215,7 +243,8 @@ struct SearchRanges {
 
 SearchRanges LevelRanges(const rig::StereoFrame& frame, const Tessellation& t,
                          const cv::Mat& map_depth, const cv::Mat& skip, const cv::Mat* coarse,
-                         const Level& level, const Inner& inner, const FovealOptions& options) {
+                         const Level& level, const Inner& inner, const SilentCheck& wide,
+                         const FovealOptions& options) {
   const rig::CameraIntrinsics& k = frame.left.intrinsics;
   const double s = level.scale, z0 = t.fixation_depth_m;
   PixelDisparity disparity(frame, s);
@@ -252,6 +281,18 @@ SearchRanges LevelRanges(const rig::StereoFrame& frame, const Tessellation& t,
         dlo = std::min(a, b) - 1;
         dhi = std::max(a, b) + 1;
         r.silent.at<uchar>(y, x) = 1;
+        // Beyond the paper (FovealOptions::silent_outside_seed): where the
+        // wide search matched a surface outside the band, away from any
+        // depth edge, the band gives way to its match, as a coarser
+        // level's estimate.
+        const auto [w, confidence, smooth] = wide.At(x, y, level.scale);
+        const double ratio = wide.scale / level.scale;
+        if (options.silent_outside_seed && std::isfinite(w) && smooth &&
+            confidence >= options.silent_confidence && (w < dlo - ratio || w > dhi + ratio)) {
+          dlo = w - ratio - options.coarse_margin_px;
+          dhi = w + ratio + options.coarse_margin_px;
+          r.silent.at<uchar>(y, x) = 0;
+        }
       }
       if (!std::isfinite(dlo) || !std::isfinite(dhi)) continue;
       r.lo.at<float>(y, x) = static_cast<float>(dlo);
@@ -259,16 +300,6 @@ SearchRanges LevelRanges(const rig::StereoFrame& frame, const Tessellation& t,
     }
   return r;
 }
-
-// The wide search behind FovealOptions::silent_near_m, once per fixation
-// at one coarse resolution (2^silent_check_level full-resolution pixels
-// per pixel): every pixel the map is silent at, over every depth from
-// silent_near_m to infinity and the Z_T band.
-struct SilentCheck {
-  double scale = 1;  ///< full-resolution pixels per pixel
-  cv::Mat wide;      ///< disparity, its pixels (NaN: none); empty: no check
-  cv::Mat confidence;
-};
 
 SilentCheck CheckSilent(const rig::StereoFrame& frame, const Tessellation& t,
                         const cv::Mat& map_depth, const cv::Rect& region,
@@ -302,6 +333,17 @@ SilentCheck CheckSilent(const rig::StereoFrame& frame, const Tessellation& t,
   const DisparityMap dm = matcher.Match(level.left, level.right, lo, hi);
   c.wide = dm.disparity_px;
   c.confidence = dm.confidence;
+  c.smooth = cv::Mat::zeros(c.wide.size(), CV_8U);
+  constexpr int kSmoothRadius = 1;
+  for (int y = kSmoothRadius; y + kSmoothRadius < c.wide.rows; ++y)
+    for (int x = kSmoothRadius; x + kSmoothRadius < c.wide.cols; ++x) {
+      const float here = c.wide.at<float>(y, x);
+      bool smooth = std::isfinite(here);
+      for (int v = y - kSmoothRadius; smooth && v <= y + kSmoothRadius; ++v)
+        for (int u = x - kSmoothRadius; smooth && u <= x + kSmoothRadius; ++u)
+          smooth = std::abs(c.wide.at<float>(v, u) - here) <= 1;
+      c.smooth.at<uchar>(y, x) = smooth;
+    }
   return c;
 }
 
@@ -317,12 +359,8 @@ int DropOutsideBand(const SilentCheck& check, const Level& level, const SearchRa
     for (int x = 0; x < dm->disparity_px.cols; ++x) {
       float& d = dm->disparity_px.at<float>(y, x);
       if (!std::isfinite(d) || !ranges.silent.at<uchar>(y, x)) continue;
-      const int xc = std::min(check.wide.cols - 1, static_cast<int>((x + 0.5) / ratio));
-      const int yc = std::min(check.wide.rows - 1, static_cast<int>((y + 0.5) / ratio));
-      const float w = check.wide.at<float>(yc, xc);
-      if (!std::isfinite(w) || check.confidence.at<float>(yc, xc) < options.silent_confidence)
-        continue;
-      const double wl = w * ratio;
+      const auto [wl, confidence, smooth] = check.At(x, y, level.scale);
+      if (!std::isfinite(wl) || confidence < options.silent_confidence) continue;
       if (wl < ranges.lo.at<float>(y, x) - ratio || wl > ranges.hi.at<float>(y, x) + ratio) {
         d = std::numeric_limits<float>::quiet_NaN();
         ++dropped;
@@ -537,7 +575,8 @@ void MatchRectifiedPeriphery(const FixationFrame& matched, const Eigen::Vector3d
   }
   const Level level =
       MakeLevel(frame, tr, index, options.rectified_periphery_full_resolution ? 0 : index);
-  const SearchRanges ranges = LevelRanges(frame, tr, depth, skip, nullptr, level, inner, options);
+  const SearchRanges ranges =
+      LevelRanges(frame, tr, depth, skip, nullptr, level, inner, silent, options);
   DisparityMap dm = matcher.Match(level.left, level.right, ranges.lo, ranges.hi);
   FovealOptions drop = options;
   drop.silent_confidence = options.rectified_silent_confidence;
@@ -619,7 +658,7 @@ FovealResult FovealStereo(const FixationFrame& matched, const Eigen::Vector3d& f
     const cv::Mat* coarse = index + 1 < levels ? &result.disparity_px[index + 1] : nullptr;
     const Inner inner = FinerLevel(t, index);
     SearchRanges ranges = LevelRanges(frame, t, map_depth, index > 0 ? skip : cv::Mat(), coarse,
-                                      level, inner, options);
+                                      level, inner, silent, options);
     DisparityMap dm = matcher.Match(level.left, level.right, ranges.lo, ranges.hi);
     const int outside_band =
         silent.wide.empty() ? 0 : DropOutsideBand(silent, level, ranges, options, &dm);

@@ -49,6 +49,15 @@ struct FovealOptions {
   /// at (its cost grows with the depth range in pixels: at full resolution
   /// it would cost more than all the levels' band searches together).
   int silent_check_level = 2;
+  /// Beyond the paper: at a pixel the map is silent at, where the wide
+  /// search matched outside the band with at least `silent_confidence`,
+  /// and its neighbours' matches lie within one of its pixels (no depth
+  /// edge), the pixel is searched about that match (+- coarse_margin_px
+  /// beyond its pixel) instead of over the band, where any match would be
+  /// dropped: surfaces outside Z_T get mapped. Off: over the accuracy
+  /// benchmark it moved good_coverage within the seed-to-seed spread and
+  /// put two runs' edge_bad_share over 0.15 (README, "The map's trust").
+  bool silent_outside_seed = false;
   /// Beyond the paper: pixels within this many level pixels of a pixel whose
   /// disparity is more than edge_jump_px smaller are dropped before the
   /// patches are fitted (window matching fattens a nearer surface over a

@@ -172,6 +172,11 @@ inline constexpr ParamSpec kFovealSilentConfidence{
     "foveal.silent_confidence",
     "see foveal.silent_check: the wider search's match confidence needed to drop a band match", 0,
     1};
+inline constexpr ParamSpec kFovealSilentOutsideSeed{
+    "foveal.silent_outside_seed",
+    "see foveal.silent_check: beyond the paper, a silent pixel whose wide search matched outside "
+    "the band with foveal.silent_confidence, away from depth edges, is searched about that match "
+    "instead of over the band (false: only the band)"};
 inline constexpr ParamSpec kFovealEdgeErosionPx{
     "foveal.edge_erosion_px",
     "beyond the paper: matches within this many level pixels of a disparity more than "
