@@ -214,7 +214,8 @@ struct SilentCheck {
   cv::Mat wide;      ///< disparity, its pixels (NaN: none); empty: no check
   cv::Mat confidence;
   /// CV_8U, non-zero where the match and its 8 neighbours' lie within one
-  /// of its pixels of one another: no depth edge about it.
+  /// of its pixels of one another: no depth edge about it (worked out only
+  /// for FovealOptions::silent_outside_seed; zero otherwise).
   cv::Mat smooth;
   /// The wide search's match about pixel (x, y) of a level of `level_scale`
   /// full-resolution pixels per pixel: its disparity in that level's pixels
@@ -285,13 +286,15 @@ SearchRanges LevelRanges(const rig::StereoFrame& frame, const Tessellation& t,
         // wide search matched a surface outside the band, away from any
         // depth edge, the band gives way to its match, as a coarser
         // level's estimate.
-        const auto [w, confidence, smooth] = wide.At(x, y, level.scale);
-        const double ratio = wide.scale / level.scale;
-        if (options.silent_outside_seed && std::isfinite(w) && smooth &&
-            confidence >= options.silent_confidence && (w < dlo - ratio || w > dhi + ratio)) {
-          dlo = w - ratio - options.coarse_margin_px;
-          dhi = w + ratio + options.coarse_margin_px;
-          r.silent.at<uchar>(y, x) = 0;
+        if (options.silent_outside_seed) {
+          const auto [w, confidence, smooth] = wide.At(x, y, level.scale);
+          const double ratio = wide.scale / level.scale;
+          if (std::isfinite(w) && smooth && confidence >= options.silent_confidence &&
+              (w < dlo - ratio || w > dhi + ratio)) {
+            dlo = w - ratio - options.coarse_margin_px;
+            dhi = w + ratio + options.coarse_margin_px;
+            r.silent.at<uchar>(y, x) = 0;
+          }
         }
       }
       if (!std::isfinite(dlo) || !std::isfinite(dhi)) continue;
@@ -334,13 +337,13 @@ SilentCheck CheckSilent(const rig::StereoFrame& frame, const Tessellation& t,
   c.wide = dm.disparity_px;
   c.confidence = dm.confidence;
   c.smooth = cv::Mat::zeros(c.wide.size(), CV_8U);
-  constexpr int kSmoothRadius = 1;
-  for (int y = kSmoothRadius; y + kSmoothRadius < c.wide.rows; ++y)
-    for (int x = kSmoothRadius; x + kSmoothRadius < c.wide.cols; ++x) {
+  if (!options.silent_outside_seed) return c;  // only it reads `smooth`
+  for (int y = 1; y + 1 < c.wide.rows; ++y)
+    for (int x = 1; x + 1 < c.wide.cols; ++x) {
       const float here = c.wide.at<float>(y, x);
       bool smooth = std::isfinite(here);
-      for (int v = y - kSmoothRadius; smooth && v <= y + kSmoothRadius; ++v)
-        for (int u = x - kSmoothRadius; smooth && u <= x + kSmoothRadius; ++u)
+      for (int v = y - 1; smooth && v <= y + 1; ++v)
+        for (int u = x - 1; smooth && u <= x + 1; ++u)
           smooth = std::abs(c.wide.at<float>(v, u) - here) <= 1;
       c.smooth.at<uchar>(y, x) = smooth;
     }

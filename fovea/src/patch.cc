@@ -3,8 +3,9 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <future>
 #include <limits>
+
+#include "fovea/parallel.h"
 
 namespace fovea {
 
@@ -210,25 +211,19 @@ std::vector<BlockFit> FitBlocks(const cv::Mat& disparity, int size, const PlaneF
                                 const BlockOptions& blocks,
                                 const std::function<bool(int x, int y, int size)>& keep,
                                 const cv::Mat& unbounded) {
-  // Rows of blocks [first, end), in order.
-  auto fit_rows = [&](int first, int end, std::vector<BlockFit>* out) {
-    for (int row = first; row < end; ++row)
-      for (int bx = 0; bx + size <= disparity.cols; bx += size)
-        if (!keep || keep(bx, row * size, size))
-          FitBlock(disparity, unbounded, bx, row * size, size, options, blocks, out);
-  };
-  const int rows = disparity.rows / size;
-  std::vector<BlockFit> out, lower;
   // A large level's block rows on two threads, the lower half's fits
   // appended after the upper's: the same fits in the same order.
   constexpr int kThreadedMinBlocks = 256;
-  if (rows < 2 || rows * (disparity.cols / size) < kThreadedMinBlocks) {
-    fit_rows(0, rows, &out);
-    return out;
-  }
-  auto other = std::async(std::launch::async, fit_rows, rows / 2, rows, &lower);
-  fit_rows(0, rows / 2, &out);
-  other.get();
+  const int rows = disparity.rows / size;
+  std::vector<BlockFit> out, lower;
+  ForHalves(rows, rows * (disparity.cols / size) >= kThreadedMinBlocks,
+            [&](size_t first, size_t end) {
+              std::vector<BlockFit>* fits = first == 0 ? &out : &lower;
+              for (int row = static_cast<int>(first); row < static_cast<int>(end); ++row)
+                for (int bx = 0; bx + size <= disparity.cols; bx += size)
+                  if (!keep || keep(bx, row * size, size))
+                    FitBlock(disparity, unbounded, bx, row * size, size, options, blocks, fits);
+            });
   out.insert(out.end(), lower.begin(), lower.end());
   return out;
 }
@@ -467,15 +462,15 @@ void PatchMap::Render(const Eigen::Isometry3d& world_T_camera, const rig::Camera
       auto edge = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
         return (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
       };
+      // Inside, each edge function times the area is at least -1e-9 area^2
+      // (the test's tolerance); far wider here, so that no rounding excludes
+      // a column the test would take.
+      const double tolerance = 1e-6 * (area * area + 1);
       for (int v = v0; v <= v1; ++v) {
         // The row's columns inside the triangle, with a pixel to spare
-        // either side: only they are tested below, which decides. Inside,
-        // each edge function times the area is at least -1e-9 area^2 (the
-        // test's tolerance), affine along the row: slope * u + offset,
-        // with a far wider tolerance here so that no rounding excludes a
-        // column the test would take.
+        // either side: only they are tested below, which decides. Each edge
+        // function times the area is affine along the row: slope * u + offset.
         double lo = u0 - 1, hi = u1 + 1;
-        const double tolerance = 1e-6 * (area * area + 1);
         for (int e = 0; e < 3; ++e) {
           const Eigen::Vector2d &a = uv[(e + 1) % 3], &b = uv[(e + 2) % 3];
           const double slope = -(b - a).y() * area,
@@ -484,8 +479,12 @@ void PatchMap::Render(const Eigen::Isometry3d& world_T_camera, const rig::Camera
           if (slope > 0) lo = std::max(lo, -offset / slope);
           if (slope < 0) hi = std::min(hi, -offset / slope);
         }
-        const int first = std::max(u0, static_cast<int>(std::floor(std::max(lo, u0 - 1.0))) - 1);
-        const int last = std::min(u1, static_cast<int>(std::ceil(std::min(hi, u1 + 1.0))) + 1);
+        // Both bounds within [u0 - 1, u1 + 1] before the conversion (a
+        // sliver's edge can put one far beyond the image).
+        const int first =
+            std::max(u0, static_cast<int>(std::floor(std::clamp(lo, u0 - 1.0, u1 + 1.0))) - 1);
+        const int last =
+            std::min(u1, static_cast<int>(std::ceil(std::clamp(hi, u0 - 1.0, u1 + 1.0))) + 1);
         for (int u = first; u <= last; ++u) {
           const Eigen::Vector2d p(u, v);
           const double w0 = edge(uv[1], uv[2], p) / area, w1 = edge(uv[2], uv[0], p) / area;

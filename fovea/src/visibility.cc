@@ -5,10 +5,10 @@
 #include <bitset>
 #include <cmath>
 #include <cstdint>
-#include <future>
 #include <optional>
 
 #include "fovea/geometry.h"
+#include "fovea/parallel.h"
 
 namespace fovea {
 namespace {
@@ -121,14 +121,7 @@ std::vector<std::uint8_t> HiddenQuarters(const PatchMap& patches, const rig::Cam
     }
   };
   constexpr size_t kThreadedMinPatches = 64;
-  const size_t half = patches.size() / 2;
-  if (patches.size() < kThreadedMinPatches) {
-    judge(0, patches.size());
-  } else {
-    auto first = std::async(std::launch::async, judge, size_t{0}, half);
-    judge(half, patches.size());
-    first.get();
-  }
+  ForHalves(patches.size(), patches.size() >= kThreadedMinPatches, judge);
   return hidden;
 }
 
