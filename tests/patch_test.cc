@@ -422,6 +422,51 @@ TEST_CASE("erosion at disparity jumps drops the nearer side's edge, whatever NaN
   }
 }
 
+TEST_CASE("erosion at disparity jumps follows its rule on random disparities of any shape",
+          "[fovea][patch]") {
+  // Disparities scattered about three surfaces with NaNs among them, on
+  // maps one or two pixels wide or tall as well as larger ones, and jumps
+  // that a float holds exactly or not: every pixel goes exactly when the
+  // rule written plainly says so.
+  const float kNaN = std::numeric_limits<float>::quiet_NaN();
+  cv::RNG rng(7);
+  for (const cv::Size size : {cv::Size(1, 9), cv::Size(2, 9), cv::Size(9, 1), cv::Size(9, 2),
+                              cv::Size(3, 3), cv::Size(37, 23)})
+    for (const double jump : {1.5, 0.7, 2.3}) {
+      INFO("size " << size << ", jump " << jump);
+      cv::Mat d(size, CV_32F);
+      for (int y = 0; y < d.rows; ++y)
+        for (int x = 0; x < d.cols; ++x)
+          d.at<float>(y, x) =
+              rng.uniform(0.0, 1.0) < 0.2
+                  ? kNaN
+                  : static_cast<float>(10.0 * rng.uniform(1, 4) + rng.uniform(-1.0, 1.0));
+      cv::Mat eroded = d.clone();
+      const int n = fovea::ErodeAtDisparityJumps(2, jump, &eroded);
+      auto surface = [&](int u, int v) {
+        const double here = d.at<float>(v, u);
+        int support = 0;
+        for (int j = std::max(0, v - 1); j <= std::min(d.rows - 1, v + 1); ++j)
+          for (int i = std::max(0, u - 1); i <= std::min(d.cols - 1, u + 1); ++i)
+            support += (i != u || j != v) && std::abs(d.at<float>(j, i) - here) <= jump;
+        return std::isfinite(here) && support >= 3;
+      };
+      int expected = 0;
+      for (int y = 0; y < d.rows; ++y)
+        for (int x = 0; x < d.cols; ++x) {
+          const float before = d.at<float>(y, x);
+          bool near_jump = false;
+          for (int v = std::max(0, y - 2); v <= std::min(d.rows - 1, y + 2); ++v)
+            for (int u = std::max(0, x - 2); u <= std::min(d.cols - 1, x + 2); ++u)
+              near_jump = near_jump || (before - d.at<float>(v, u) > jump && surface(u, v));
+          expected += near_jump;
+          INFO("pixel (" << x << ", " << y << ")");
+          CHECK(std::isnan(eroded.at<float>(y, x)) == (std::isnan(before) || near_jump));
+        }
+      CHECK(n == expected);
+    }
+}
+
 TEST_CASE("matches beside a wide unmatched stretch are found along rows and columns",
           "[fovea][patch]") {
   // A nearer surface (disparity 20) left of x = 20, the farther one

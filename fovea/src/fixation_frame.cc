@@ -80,6 +80,12 @@ rig::CameraView TurnView(const rig::CameraView& view, const Eigen::Matrix3d& rol
   return out;
 }
 
+// `view` without its colour image (the grey one and the pose shared).
+rig::CameraView Grey(rig::CameraView view) {
+  view.bgr = cv::Mat();
+  return view;
+}
+
 // CV_8U, 255 where every source pixel of the bilinear sample through `H`
 // (original -> turned) lies inside the original image of `size`.
 cv::Mat ValidAfter(cv::Size size, const cv::Matx33d& H) {
@@ -124,8 +130,10 @@ FixationFrame ToFixationFrame(const rig::StereoFrame& frame) {
   f.original = frame;
   f.views.state = frame.state;
   f.views.timestamp_s = frame.timestamp_s;
-  f.views.left = TurnView(frame.left, tl, frame.left.intrinsics, &f.left_H);
-  f.views.right = TurnView(frame.right, tr, frame.left.intrinsics, &f.right_H);
+  // Grey only: the pair is matched in and drawn on in grey, and turning
+  // the colour images too cost more than the grey ones.
+  f.views.left = TurnView(Grey(frame.left), tl, frame.left.intrinsics, &f.left_H);
+  f.views.right = TurnView(Grey(frame.right), tr, frame.left.intrinsics, &f.right_H);
   f.left_valid = ValidAfter(frame.left.gray.size(), f.left_H);
   return f;
 }
@@ -150,12 +158,8 @@ FixationFrame ToRectifiedFrame(const rig::StereoFrame& frame) {
   f.views.state = frame.state;
   f.views.timestamp_s = frame.timestamp_s;
   // Grey only: the rectified pair is matched, never shown.
-  auto grey = [](rig::CameraView view) {
-    view.bgr = cv::Mat();
-    return view;
-  };
-  f.views.left = TurnView(grey(frame.left), rect, k, &f.left_H);
-  f.views.right = TurnView(grey(frame.right), rect, k, &f.right_H);
+  f.views.left = TurnView(Grey(frame.left), rect, k, &f.left_H);
+  f.views.right = TurnView(Grey(frame.right), rect, k, &f.right_H);
   f.left_valid = ValidAfter(frame.left.gray.size(), f.left_H);
   return f;
 }

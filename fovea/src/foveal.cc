@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "fovea/geometry.h"
+#include "fovea/parallel.h"
 #include "fovea/params.h"
 #include "fovea/timing.h"
 #include "rig/left_pair.h"
@@ -248,59 +249,64 @@ SearchRanges LevelRanges(const rig::StereoFrame& frame, const Tessellation& t,
                          const FovealOptions& options) {
   const rig::CameraIntrinsics& k = frame.left.intrinsics;
   const double s = level.scale, z0 = t.fixation_depth_m;
-  PixelDisparity disparity(frame, s);
   const cv::Size size = level.left.size();
   const LevelGrid grid(size, s, k);
   SearchRanges r{cv::Mat(size, CV_32F, cv::Scalar(1)), cv::Mat(size, CV_32F, cv::Scalar(0)),
                  cv::Mat(size, CV_8U, cv::Scalar(0))};
   // The level's pixels whose centres may fall in its rectangle.
   const cv::Rect inside = LevelPixels(level.rect, s) & cv::Rect(cv::Point(), size);
-  for (int y = inside.y; y < inside.br().y; ++y)
-    for (int x = inside.x; x < inside.br().x; ++x) {
-      const auto [u, v, ui, vi] = grid.At(x, y);
-      if (!level.rect.contains({ui, vi}) || t.mask.at<uchar>(vi, ui) == 0) continue;
-      // (The finer level's coarse estimates are needed inside it.)
-      if (!skip.empty() && skip.at<uchar>(vi, ui) && !inner.Contains({ui, vi})) continue;
-      double dlo, dhi;
-      const float cd = coarse ? coarse->at<float>(std::min(coarse->rows - 1, y / 2),
-                                                  std::min(coarse->cols - 1, x / 2))
-                              : std::numeric_limits<float>::quiet_NaN();
-      const float z = map_depth.at<float>(vi, ui);
-      if (std::isfinite(cd)) {
-        // The coarser level's estimate, in this level's pixels.
-        dlo = 2 * cd - options.coarse_margin_px;
-        dhi = 2 * cd + options.coarse_margin_px;
-      } else if (z > 0) {
-        disparity.At(u, grid.Ray(x, y));
-        const double d = disparity(z);
-        dlo = d - options.map_margin_px;
-        dhi = d + options.map_margin_px;
-      } else {
-        // The map is silent: anything within Z_T of the fixation depth.
-        disparity.At(u, grid.Ray(x, y));
-        const double a = disparity(z0 - t.z_t_near_m), b = disparity(z0 + t.z_t_far_m);
-        dlo = std::min(a, b) - 1;
-        dhi = std::max(a, b) + 1;
-        r.silent.at<uchar>(y, x) = 1;
-        // Beyond the paper (FovealOptions::silent_outside_seed): where the
-        // wide search matched a surface outside the band, away from any
-        // depth edge, the band gives way to its match, as a coarser
-        // level's estimate.
-        if (options.silent_outside_seed) {
-          const auto [w, confidence, smooth] = wide.At(x, y, level.scale);
-          const double ratio = wide.scale / level.scale;
-          if (std::isfinite(w) && smooth && confidence >= options.silent_confidence &&
-              (w < dlo - ratio || w > dhi + ratio)) {
-            dlo = w - ratio - options.coarse_margin_px;
-            dhi = w + ratio + options.coarse_margin_px;
-            r.silent.at<uchar>(y, x) = 0;
+  // Rows are independent: a large level's are split between two threads.
+  auto rows = [&](size_t begin, size_t end) {
+    PixelDisparity disparity(frame, s);
+    for (int y = inside.y + static_cast<int>(begin); y < inside.y + static_cast<int>(end); ++y)
+      for (int x = inside.x; x < inside.br().x; ++x) {
+        const auto [u, v, ui, vi] = grid.At(x, y);
+        if (!level.rect.contains({ui, vi}) || t.mask.at<uchar>(vi, ui) == 0) continue;
+        // (The finer level's coarse estimates are needed inside it.)
+        if (!skip.empty() && skip.at<uchar>(vi, ui) && !inner.Contains({ui, vi})) continue;
+        double dlo, dhi;
+        const float cd = coarse ? coarse->at<float>(std::min(coarse->rows - 1, y / 2),
+                                                    std::min(coarse->cols - 1, x / 2))
+                                : std::numeric_limits<float>::quiet_NaN();
+        const float z = map_depth.at<float>(vi, ui);
+        if (std::isfinite(cd)) {
+          // The coarser level's estimate, in this level's pixels.
+          dlo = 2 * cd - options.coarse_margin_px;
+          dhi = 2 * cd + options.coarse_margin_px;
+        } else if (z > 0) {
+          disparity.At(u, grid.Ray(x, y));
+          const double d = disparity(z);
+          dlo = d - options.map_margin_px;
+          dhi = d + options.map_margin_px;
+        } else {
+          // The map is silent: anything within Z_T of the fixation depth.
+          disparity.At(u, grid.Ray(x, y));
+          const double a = disparity(z0 - t.z_t_near_m), b = disparity(z0 + t.z_t_far_m);
+          dlo = std::min(a, b) - 1;
+          dhi = std::max(a, b) + 1;
+          r.silent.at<uchar>(y, x) = 1;
+          // Beyond the paper (FovealOptions::silent_outside_seed): where the
+          // wide search matched a surface outside the band, away from any
+          // depth edge, the band gives way to its match, as a coarser
+          // level's estimate.
+          if (options.silent_outside_seed) {
+            const auto [w, confidence, smooth] = wide.At(x, y, level.scale);
+            const double ratio = wide.scale / level.scale;
+            if (std::isfinite(w) && smooth && confidence >= options.silent_confidence &&
+                (w < dlo - ratio || w > dhi + ratio)) {
+              dlo = w - ratio - options.coarse_margin_px;
+              dhi = w + ratio + options.coarse_margin_px;
+              r.silent.at<uchar>(y, x) = 0;
+            }
           }
         }
+        if (!std::isfinite(dlo) || !std::isfinite(dhi)) continue;
+        r.lo.at<float>(y, x) = static_cast<float>(dlo);
+        r.hi.at<float>(y, x) = static_cast<float>(dhi);
       }
-      if (!std::isfinite(dlo) || !std::isfinite(dhi)) continue;
-      r.lo.at<float>(y, x) = static_cast<float>(dlo);
-      r.hi.at<float>(y, x) = static_cast<float>(dhi);
-    }
+  };
+  constexpr int kThreadedMinPixels = 32768;
+  ForHalves(std::max(0, inside.height), inside.area() >= kThreadedMinPixels, rows);
   return r;
 }
 
@@ -402,21 +408,37 @@ int ErodeAtDisparityJumps(int radius, double jump_px, cv::Mat* disparity) {
   // good matches around it.
   constexpr int kSupport = 3;
   cv::Mat farthest(d.size(), CV_32F, cv::Scalar(std::numeric_limits<float>::infinity()));
+  // The comparison |a - b| <= jump_px of two floats, in floats: against
+  // the largest float not above jump_px (the same answer), so that the
+  // loop below vectorizes. NaN is near nothing.
+  float jump = static_cast<float>(jump_px);
+  if (jump > jump_px) jump = std::nextafter(jump, -std::numeric_limits<float>::infinity());
+  auto near = [jump](float a, float b) { return int{std::abs(a - b) <= jump}; };
+  // The rows above and below (NaN beyond the box: there the image ends or
+  // nothing is matched).
+  const std::vector<float> none(d.cols, std::numeric_limits<float>::quiet_NaN());
   for (int y = 0; y < d.rows; ++y) {
-    // The rows above and below (none beyond the box: there the image ends or
-    // nothing is matched).
-    const float* rows[3] = {y > 0 ? d.ptr<float>(y - 1) : nullptr, d.ptr<float>(y),
-                            y + 1 < d.rows ? d.ptr<float>(y + 1) : nullptr};
+    const float* up = y > 0 ? d.ptr<float>(y - 1) : none.data();
+    const float* mid = d.ptr<float>(y);
+    const float* down = y + 1 < d.rows ? d.ptr<float>(y + 1) : none.data();
     float* out = farthest.ptr<float>(y);
-    for (int x = 0; x < d.cols; ++x) {
-      const float here = rows[1][x];
+    // The columns with both neighbours, branch-free; then the box's first
+    // and last column.
+    for (int x = 1; x + 1 < d.cols; ++x) {
+      const float here = mid[x];
+      const int support = near(up[x - 1], here) + near(up[x], here) + near(up[x + 1], here) +
+                          near(mid[x - 1], here) + near(mid[x + 1], here) +
+                          near(down[x - 1], here) + near(down[x], here) + near(down[x + 1], here);
+      out[x] = support >= kSupport && std::isfinite(here) ? here : out[x];
+    }
+    for (const int x : {0, d.cols - 1}) {
+      const float here = mid[x];
       if (!std::isfinite(here)) continue;
       const int u0 = std::max(0, x - 1), u1 = std::min(d.cols - 1, x + 1);
       int support = 0;
-      for (const float* row : rows)
-        if (row)
-          for (int u = u0; u <= u1; ++u)
-            support += (u != x || row != rows[1]) && std::abs(row[u] - here) <= jump_px;
+      for (int u = u0; u <= u1; ++u) support += near(up[u], here) + near(down[u], here);
+      for (const int u : {x - 1, x + 1})
+        if (u >= u0 && u <= u1) support += near(mid[u], here);
       if (support >= kSupport) out[x] = here;
     }
   }

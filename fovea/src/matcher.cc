@@ -39,8 +39,8 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 // The level is matched in strips of this many rows; each disparity's costs
 // span only the columns some pixel of the strip needs them at.
 constexpr int kStripRows = 16;
-// Crops with at least this many pixels to match (past the texture test)
-// are matched on two threads (Nl1Matcher::MatchCrop).
+// Crops with at least this many pixels to search (before the texture
+// test) are matched on two threads (Nl1Matcher::MatchCrop).
 constexpr int kThreadedMinPixels = 8192;
 // Within a row, the columns are grouped in chunks of this many (chunk k:
 // [k * kChunkCols, (k + 1) * kChunkCols) of the matched crop), the block of
@@ -889,15 +889,15 @@ void Nl1Matcher::MatchCrop(const Nl1Options& options, const cv::Mat& left, const
   }
   Bands bands{cv::Mat(left.size(), CV_32S, cv::Scalar(1)),
               cv::Mat(left.size(), CV_32S, cv::Scalar(0))};
-  SearchBands(image, ml, lo_px, hi_px, options, h, left.rows - h, &bands, &out);
   // Strips of rows are independent: every other strip from `first` on,
-  // each with its own cost volume, into `o` (rows apart from the other
-  // half's, in the same maps).
+  // each with its own bands, texture test and cost volume, into `o` (rows
+  // apart from the other half's, in the same maps).
   auto match_strips = [&](int first, DisparityMap* o) {
     CostVolume v;
     RowWinners w(left.cols);
     for (int y0 = h + first * kStripRows; y0 < left.rows - h; y0 += 2 * kStripRows) {
       const int y1 = std::min(y0 + kStripRows, left.rows - h);
+      SearchBands(image, ml, lo_px, hi_px, options, y0, y1, &bands, o);
       if (!SizeVolume(bands, y0, y1, h, &v)) continue;
       if (prenormalized)
         FillPrenormalized(a, b, h, &v);
@@ -919,7 +919,7 @@ void Nl1Matcher::MatchCrop(const Nl1Options& options, const cv::Mat& left, const
   odd.disparity_px = out.disparity_px;
   odd.confidence = out.confidence;
   std::future<void> other;
-  if (out.searched - out.rejected_texture >= kThreadedMinPixels)
+  if (cv::countNonZero(lo_px <= hi_px) >= kThreadedMinPixels)
     other = std::async(std::launch::async, match_strips, 1, &odd);
   else
     match_strips(1, &out);

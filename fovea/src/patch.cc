@@ -428,85 +428,103 @@ void PatchMap::Render(const Eigen::Isometry3d& world_T_camera, const rig::Camera
   cv::Mat depth(k.height_px, k.width_px, CV_32F, cv::Scalar(0));
   cv::Mat ids(k.height_px, k.width_px, CV_32S, cv::Scalar(-1));
   const Eigen::Isometry3d camera_T_world = world_T_camera.inverse();
-  for (size_t i = 0; i < patches_.size(); ++i) {
-    std::array<Eigen::Vector3d, 4> p_C;
-    bool in_front = true;
-    for (int j = 0; j < 4; ++j) {
-      p_C[j] = camera_T_world * patches_[i].corners_W[j];
-      if (p_C[j].z() < 1e-3) in_front = false;
-    }
-    if (!in_front) continue;
-    // Rasterize the two triangles; 1/z is affine in screen space.
-    for (const auto& tri : {std::array<int, 3>{0, 1, 2}, std::array<int, 3>{0, 2, 3}}) {
-      Eigen::Vector2d uv[3];
-      double inv_z[3];
-      for (int j = 0; j < 3; ++j) {
-        const Eigen::Vector3d& q = p_C[tri[j]];
-        uv[j] =
-            Eigen::Vector2d(k.fx_px * q.x() / q.z() + k.cx_px, k.fy_px * q.y() / q.z() + k.cy_px);
-        inv_z[j] = 1.0 / q.z();
+  // The rows are drawn in bands of kBandRows, every other band by each of
+  // two threads (`half` 0 and 1), each going through every patch in order:
+  // each pixel sees the patches in the same order either way, so the render
+  // does not depend on the split.
+  constexpr int kBandRows = 8;
+  auto draw = [&](size_t half, size_t halves) {
+    for (size_t i = 0; i < patches_.size(); ++i) {
+      std::array<Eigen::Vector3d, 4> p_C;
+      bool in_front = true;
+      for (int j = 0; j < 4; ++j) {
+        p_C[j] = camera_T_world * patches_[i].corners_W[j];
+        if (p_C[j].z() < 1e-3) in_front = false;
       }
-      const double area =
-          (uv[1] - uv[0]).x() * (uv[2] - uv[0]).y() - (uv[1] - uv[0]).y() * (uv[2] - uv[0]).x();
-      if (std::abs(area) < 1e-12) continue;
-      const int u0 = std::max(
-          drawn.x, static_cast<int>(std::ceil(std::min({uv[0].x(), uv[1].x(), uv[2].x()}))));
-      const int u1 =
-          std::min(drawn.x + drawn.width - 1,
-                   static_cast<int>(std::floor(std::max({uv[0].x(), uv[1].x(), uv[2].x()}))));
-      const int v0 = std::max(
-          drawn.y, static_cast<int>(std::ceil(std::min({uv[0].y(), uv[1].y(), uv[2].y()}))));
-      const int v1 =
-          std::min(drawn.y + drawn.height - 1,
-                   static_cast<int>(std::floor(std::max({uv[0].y(), uv[1].y(), uv[2].y()}))));
-      auto edge = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
-        return (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
-      };
-      // Inside, each edge function times the area is at least -1e-9 area^2
-      // (the test's tolerance); far wider here, so that no rounding excludes
-      // a column the test would take.
-      const double tolerance = 1e-6 * (area * area + 1);
-      for (int v = v0; v <= v1; ++v) {
-        // The row's columns inside the triangle, with a pixel to spare
-        // either side: only they are tested below, which decides. Each edge
-        // function times the area is affine along the row: slope * u + offset.
-        double lo = u0 - 1, hi = u1 + 1;
-        for (int e = 0; e < 3; ++e) {
-          const Eigen::Vector2d &a = uv[(e + 1) % 3], &b = uv[(e + 2) % 3];
-          const double slope = -(b - a).y() * area,
-                       offset =
-                           ((b - a).x() * (v - a.y()) + (b - a).y() * a.x()) * area + tolerance;
-          if (slope > 0) lo = std::max(lo, -offset / slope);
-          if (slope < 0) hi = std::min(hi, -offset / slope);
+      if (!in_front) continue;
+      // Rasterize the two triangles; 1/z is affine in screen space.
+      for (const auto& tri : {std::array<int, 3>{0, 1, 2}, std::array<int, 3>{0, 2, 3}}) {
+        Eigen::Vector2d uv[3];
+        double inv_z[3];
+        for (int j = 0; j < 3; ++j) {
+          const Eigen::Vector3d& q = p_C[tri[j]];
+          uv[j] =
+              Eigen::Vector2d(k.fx_px * q.x() / q.z() + k.cx_px, k.fy_px * q.y() / q.z() + k.cy_px);
+          inv_z[j] = 1.0 / q.z();
         }
-        // Both bounds within [u0 - 1, u1 + 1] before the conversion (a
-        // sliver's edge can put one far beyond the image).
-        const int first =
-            std::max(u0, static_cast<int>(std::floor(std::clamp(lo, u0 - 1.0, u1 + 1.0))) - 1);
-        const int last =
-            std::min(u1, static_cast<int>(std::ceil(std::clamp(hi, u0 - 1.0, u1 + 1.0))) + 1);
-        for (int u = first; u <= last; ++u) {
-          const Eigen::Vector2d p(u, v);
-          const double w0 = edge(uv[1], uv[2], p) / area, w1 = edge(uv[2], uv[0], p) / area;
-          const double w2 = 1 - w0 - w1;
-          if (w0 < -1e-9 || w1 < -1e-9 || w2 < -1e-9) continue;
-          const double z = 1.0 / (w0 * inv_z[0] + w1 * inv_z[1] + w2 * inv_z[2]);
-          float& d = depth.at<float>(v, u);
-          int& id = ids.at<int>(v, u);
-          bool take = d == 0 || z < d;
-          if (d != 0 && SameSurface(z, patches_[i], d, patches_[id])) {
-            // The same surface seen twice: the finer level wins.
-            const int mine = patches_[i].Fineness(), theirs = patches_[id].Fineness();
-            take = mine > theirs || (mine == theirs && z < d);
+        const double area =
+            (uv[1] - uv[0]).x() * (uv[2] - uv[0]).y() - (uv[1] - uv[0]).y() * (uv[2] - uv[0]).x();
+        if (std::abs(area) < 1e-12) continue;
+        const int u0 = std::max(
+            drawn.x, static_cast<int>(std::ceil(std::min({uv[0].x(), uv[1].x(), uv[2].x()}))));
+        const int u1 =
+            std::min(drawn.x + drawn.width - 1,
+                     static_cast<int>(std::floor(std::max({uv[0].x(), uv[1].x(), uv[2].x()}))));
+        const int v0 = std::max(
+            drawn.y, static_cast<int>(std::ceil(std::min({uv[0].y(), uv[1].y(), uv[2].y()}))));
+        const int v1 =
+            std::min(drawn.y + drawn.height - 1,
+                     static_cast<int>(std::floor(std::max({uv[0].y(), uv[1].y(), uv[2].y()}))));
+        auto edge = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                       const Eigen::Vector2d& c) {
+          return (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+        };
+        // Inside, each edge function times the area is at least -1e-9 area^2
+        // (the test's tolerance); far wider here, so that no rounding excludes
+        // a column the test would take.
+        const double tolerance = 1e-6 * (area * area + 1);
+        for (int v = v0; v <= v1; ++v) {
+          if (halves == 2 && static_cast<size_t>((v / kBandRows) % 2) != half) {
+            v = (v / kBandRows + 1) * kBandRows - 1;  // to the next band's first row
+            continue;
           }
-          if (take) {
-            d = static_cast<float>(z);
-            id = static_cast<int>(i);
+          // The row's columns inside the triangle, with a pixel to spare
+          // either side: only they are tested below, which decides. Each edge
+          // function times the area is affine along the row: slope * u + offset.
+          double lo = u0 - 1, hi = u1 + 1;
+          for (int e = 0; e < 3; ++e) {
+            const Eigen::Vector2d &a = uv[(e + 1) % 3], &b = uv[(e + 2) % 3];
+            const double slope = -(b - a).y() * area,
+                         offset =
+                             ((b - a).x() * (v - a.y()) + (b - a).y() * a.x()) * area + tolerance;
+            if (slope > 0) lo = std::max(lo, -offset / slope);
+            if (slope < 0) hi = std::min(hi, -offset / slope);
+          }
+          // Both bounds within [u0 - 1, u1 + 1] before the conversion (a
+          // sliver's edge can put one far beyond the image).
+          const int first =
+              std::max(u0, static_cast<int>(std::floor(std::clamp(lo, u0 - 1.0, u1 + 1.0))) - 1);
+          const int last =
+              std::min(u1, static_cast<int>(std::ceil(std::clamp(hi, u0 - 1.0, u1 + 1.0))) + 1);
+          for (int u = first; u <= last; ++u) {
+            const Eigen::Vector2d p(u, v);
+            const double w0 = edge(uv[1], uv[2], p) / area, w1 = edge(uv[2], uv[0], p) / area;
+            const double w2 = 1 - w0 - w1;
+            if (w0 < -1e-9 || w1 < -1e-9 || w2 < -1e-9) continue;
+            const double z = 1.0 / (w0 * inv_z[0] + w1 * inv_z[1] + w2 * inv_z[2]);
+            float& d = depth.at<float>(v, u);
+            int& id = ids.at<int>(v, u);
+            bool take = d == 0 || z < d;
+            if (d != 0 && SameSurface(z, patches_[i], d, patches_[id])) {
+              // The same surface seen twice: the finer level wins.
+              const int mine = patches_[i].Fineness(), theirs = patches_[id].Fineness();
+              take = mine > theirs || (mine == theirs && z < d);
+            }
+            if (take) {
+              d = static_cast<float>(z);
+              id = static_cast<int>(i);
+            }
           }
         }
       }
     }
-  }
+  };
+  // Two threads where there are patches and pixels enough to share: every
+  // thread projects every patch, and a small view's render is mostly that.
+  constexpr size_t kThreadedMinPatches = 256;
+  constexpr int kThreadedMinPixels = 1 << 17;
+  ForHalves(2, patches_.size() >= kThreadedMinPatches && drawn.area() >= kThreadedMinPixels,
+            [&](size_t begin, size_t end) { draw(begin, end - begin == 2 ? 1 : 2); });
   if (depth_m) *depth_m = depth;
   if (patch_ids) *patch_ids = ids;
 }

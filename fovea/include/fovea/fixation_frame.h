@@ -26,9 +26,10 @@
 namespace fovea {
 
 struct FixationFrame {
-  /// The pair as matched: rolled images (grey, and BGR when present), rolled
-  /// poses, the stage state; when resampled, both views have the left
-  /// camera's intrinsics (rows of one are rows of the other).
+  /// The pair as matched: rolled images (grey only when resampled; the
+  /// colour ones are in `original`), rolled poses, the stage state; when
+  /// resampled, both views have the left camera's intrinsics (rows of one
+  /// are rows of the other).
   rig::StereoFrame views;
   /// Original pixel -> fixation-frame pixel, per camera (the homographies
   /// of the two rotations).
