@@ -244,6 +244,45 @@ TEST_CASE("patch map: a render of a region equals the whole render there, empty 
   }
 }
 
+TEST_CASE("patch map: a large render on two threads equals its quarters' renders on one",
+          "[fovea][patch]") {
+  // 600 overlapping patches at random depths, some of them the same surface
+  // as others (the finer level wins there, else the nearer): the whole
+  // 640 x 480 view is drawn on two threads, each quarter (under the
+  // threads' 2^17 pixels) on one; every pixel agrees.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  fovea::PatchMap map;
+  for (int i = 0; i < 600; ++i) {
+    const Eigen::Vector3d centre(0.5 * u(rng), 0.4 * u(rng), 1.2 + 0.02 * std::round(4 * u(rng)));
+    const double w = 0.05 + 0.04 * u(rng), h = 0.05 + 0.04 * u(rng), slant = 0.2 * u(rng);
+    fovea::Patch p;
+    p.corners_W = {
+        centre + Eigen::Vector3d(-w, -h, -slant * w), centre + Eigen::Vector3d(w, -h, slant * w),
+        centre + Eigen::Vector3d(w, h, slant * w), centre + Eigen::Vector3d(-w, h, -slant * w)};
+    p.level = i % 3 == 0 ? fovea::PatchLevel::kFoveal : fovea::PatchLevel::kPeripheral;
+    p.sigma_z_m = 0.005;
+    map.Add(p);
+  }
+  const auto k = rig::CameraIntrinsics::FromHorizontalFov(640, 480, 1.0);
+  cv::Mat depth, ids;
+  map.Render(Eigen::Isometry3d::Identity(), k, &depth, &ids);
+  int differ = 0, drawn = 0;
+  for (const cv::Rect quarter : {cv::Rect(0, 0, 320, 240), cv::Rect(320, 0, 320, 240),
+                                 cv::Rect(0, 240, 320, 240), cv::Rect(320, 240, 320, 240)}) {
+    cv::Mat quarter_depth, quarter_ids;
+    map.Render(Eigen::Isometry3d::Identity(), k, &quarter_depth, &quarter_ids, quarter);
+    for (int v = quarter.y; v < quarter.br().y; ++v)
+      for (int x = quarter.x; x < quarter.br().x; ++x) {
+        differ += quarter_depth.at<float>(v, x) != depth.at<float>(v, x) ||
+                  quarter_ids.at<int>(v, x) != ids.at<int>(v, x);
+        drawn += ids.at<int>(v, x) >= 0;
+      }
+  }
+  CHECK(differ == 0);
+  CHECK(drawn > 640 * 480 / 2);
+}
+
 TEST_CASE("blocks across a depth step split instead of bridging it", "[fovea][patch]") {
   // A 64 x 64 disparity image: 10 px left of x = 37, 20 px right of it
   // (noise 0.1 px), except a 4 px strip left of the step where matching

@@ -428,12 +428,13 @@ void PatchMap::Render(const Eigen::Isometry3d& world_T_camera, const rig::Camera
   cv::Mat depth(k.height_px, k.width_px, CV_32F, cv::Scalar(0));
   cv::Mat ids(k.height_px, k.width_px, CV_32S, cv::Scalar(-1));
   const Eigen::Isometry3d camera_T_world = world_T_camera.inverse();
-  // The rows are drawn in bands of kBandRows, every other band by each of
-  // two threads (`half` 0 and 1), each going through every patch in order:
-  // each pixel sees the patches in the same order either way, so the render
+  // The rows are drawn in bands of kBandRows. draw(begin, end) draws the
+  // bands whose parity (band index mod 2) is in [begin, end), going through
+  // every patch in order: on two threads each draws every other band, and
+  // each pixel sees the patches in the same order as on one, so the render
   // does not depend on the split.
   constexpr int kBandRows = 8;
-  auto draw = [&](size_t half, size_t halves) {
+  auto draw = [&](size_t begin, size_t end) {
     for (size_t i = 0; i < patches_.size(); ++i) {
       std::array<Eigen::Vector3d, 4> p_C;
       bool in_front = true;
@@ -474,8 +475,9 @@ void PatchMap::Render(const Eigen::Isometry3d& world_T_camera, const rig::Camera
         // a column the test would take.
         const double tolerance = 1e-6 * (area * area + 1);
         for (int v = v0; v <= v1; ++v) {
-          if (halves == 2 && static_cast<size_t>((v / kBandRows) % 2) != half) {
-            v = (v / kBandRows + 1) * kBandRows - 1;  // to the next band's first row
+          if (const auto parity = static_cast<size_t>((v / kBandRows) % 2);
+              parity < begin || parity >= end) {
+            v = (v / kBandRows + 1) * kBandRows - 1;  // on to the next band's first row
             continue;
           }
           // The row's columns inside the triangle, with a pixel to spare
@@ -523,8 +525,7 @@ void PatchMap::Render(const Eigen::Isometry3d& world_T_camera, const rig::Camera
   // thread projects every patch, and a small view's render is mostly that.
   constexpr size_t kThreadedMinPatches = 256;
   constexpr int kThreadedMinPixels = 1 << 17;
-  ForHalves(2, patches_.size() >= kThreadedMinPatches && drawn.area() >= kThreadedMinPixels,
-            [&](size_t begin, size_t end) { draw(begin, end - begin == 2 ? 1 : 2); });
+  ForHalves(2, patches_.size() >= kThreadedMinPatches && drawn.area() >= kThreadedMinPixels, draw);
   if (depth_m) *depth_m = depth;
   if (patch_ids) *patch_ids = ids;
 }
