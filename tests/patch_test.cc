@@ -17,6 +17,25 @@ std::vector<fovea::DisparitySample> PlaneSamples(double a, double b, double c, d
       s.push_back({x0 + x + 0.3, y0 + y, a * (x0 + x + 0.3) + b * (y0 + y) + c});
   return s;
 }
+// Whether ErodeAtDisparityJumps(radius, jump, ...) should drop pixel (x,
+// y) of `d`, by its rule written plainly: a pixel within `radius` whose
+// disparity is more than `jump` below this one's, and which has at least 3
+// of its 8 neighbours within `jump` of its own.
+bool ErodedByRule(const cv::Mat& d, int x, int y, int radius, double jump) {
+  auto surface = [&](int u, int v) {
+    const double here = d.at<float>(v, u);
+    int support = 0;
+    for (int j = std::max(0, v - 1); j <= std::min(d.rows - 1, v + 1); ++j)
+      for (int i = std::max(0, u - 1); i <= std::min(d.cols - 1, u + 1); ++i)
+        support += (i != u || j != v) && std::abs(d.at<float>(j, i) - here) <= jump;
+    return std::isfinite(here) && support >= 3;
+  };
+  const float before = d.at<float>(y, x);
+  for (int v = std::max(0, y - radius); v <= std::min(d.rows - 1, y + radius); ++v)
+    for (int u = std::max(0, x - radius); u <= std::min(d.cols - 1, x + radius); ++u)
+      if (before - d.at<float>(v, u) > jump && surface(u, v)) return true;
+  return false;
+}
 fovea::Patch Square(double z, double half) {
   fovea::Patch p;
   p.corners_W = {Eigen::Vector3d(-half, -half, z), Eigen::Vector3d(half, -half, z),
@@ -425,17 +444,7 @@ TEST_CASE("erosion at disparity jumps drops the nearer side's edge, whatever NaN
       }
       // The rule written plainly: a farther pixel within the radius that has
       // at least 3 neighbours of its own surface.
-      auto surface = [&](int u, int v) {
-        int n = 0;
-        for (int j = std::max(0, v - 1); j <= std::min(d.rows - 1, v + 1); ++j)
-          for (int i = std::max(0, u - 1); i <= std::min(d.cols - 1, u + 1); ++i)
-            n += (i != u || j != v) && std::abs(d.at<float>(j, i) - d.at<float>(v, u)) <= 1.5f;
-        return n >= 3;
-      };
-      bool near_jump = false;
-      for (int v = std::max(0, y - 3); v <= std::min(d.rows - 1, y + 3); ++v)
-        for (int u = std::max(0, x - 3); u <= std::min(d.cols - 1, x + 3); ++u)
-          near_jump = near_jump || (before - d.at<float>(v, u) > 1.5f && surface(u, v));
+      const bool near_jump = ErodedByRule(d, x, y, 3, 1.5);
       expected += near_jump;
       INFO("pixel (" << x << ", " << y << ")");
       CHECK(std::isnan(after) == near_jump);
@@ -482,22 +491,11 @@ TEST_CASE("erosion at disparity jumps follows its rule on random disparities of 
                   : static_cast<float>(10.0 * rng.uniform(1, 4) + rng.uniform(-1.0, 1.0));
       cv::Mat eroded = d.clone();
       const int n = fovea::ErodeAtDisparityJumps(2, jump, &eroded);
-      auto surface = [&](int u, int v) {
-        const double here = d.at<float>(v, u);
-        int support = 0;
-        for (int j = std::max(0, v - 1); j <= std::min(d.rows - 1, v + 1); ++j)
-          for (int i = std::max(0, u - 1); i <= std::min(d.cols - 1, u + 1); ++i)
-            support += (i != u || j != v) && std::abs(d.at<float>(j, i) - here) <= jump;
-        return std::isfinite(here) && support >= 3;
-      };
       int expected = 0;
       for (int y = 0; y < d.rows; ++y)
         for (int x = 0; x < d.cols; ++x) {
           const float before = d.at<float>(y, x);
-          bool near_jump = false;
-          for (int v = std::max(0, y - 2); v <= std::min(d.rows - 1, y + 2); ++v)
-            for (int u = std::max(0, x - 2); u <= std::min(d.cols - 1, x + 2); ++u)
-              near_jump = near_jump || (before - d.at<float>(v, u) > jump && surface(u, v));
+          const bool near_jump = ErodedByRule(d, x, y, 2, jump);
           expected += near_jump;
           INFO("pixel (" << x << ", " << y << ")");
           CHECK(std::isnan(eroded.at<float>(y, x)) == (std::isnan(before) || near_jump));

@@ -306,7 +306,7 @@ SearchRanges LevelRanges(const rig::StereoFrame& frame, const Tessellation& t,
       }
   };
   constexpr int kThreadedMinPixels = 32768;
-  ForHalves(std::max(0, inside.height), inside.area() >= kThreadedMinPixels, rows);
+  ForHalves(inside.height, inside.area() >= kThreadedMinPixels, rows);
   return r;
 }
 

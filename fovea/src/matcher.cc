@@ -738,10 +738,11 @@ void AddCounts(const DisparityMap& from, DisparityMap* to) {
 }
 
 // The searched pixels (lo <= hi): their bounding box, inclusive (x1 < 0:
-// none), and the union of their bands.
+// none), the union of their bands, and how many there are.
 struct Searched {
   int x0, x1, y0, y1;
   float dlo, dhi;
+  int count;
 };
 Searched FindSearched(const cv::Mat& lo_px, const cv::Mat& hi_px) {
   Searched s{lo_px.cols,
@@ -749,7 +750,8 @@ Searched FindSearched(const cv::Mat& lo_px, const cv::Mat& hi_px) {
              lo_px.rows,
              -1,
              std::numeric_limits<float>::infinity(),
-             -std::numeric_limits<float>::infinity()};
+             -std::numeric_limits<float>::infinity(),
+             0};
   for (int y = 0; y < lo_px.rows; ++y) {
     const float* lo = lo_px.ptr<float>(y);
     const float* hi = hi_px.ptr<float>(y);
@@ -761,6 +763,7 @@ Searched FindSearched(const cv::Mat& lo_px, const cv::Mat& hi_px) {
         s.y1 = std::max(s.y1, y);
         s.dlo = std::min(s.dlo, lo[x]);
         s.dhi = std::max(s.dhi, hi[x]);
+        ++s.count;
       }
   }
   return s;
@@ -838,7 +841,7 @@ DisparityMap Nl1Matcher::MatchOneWindow(const Nl1Options& options, const cv::Mat
   // fovea is a small part of its image): their bounding box and windows,
   // and on the right the columns their bands reach.
   const int h = options.window_half_px;
-  const auto [x0, x1, y0, y1, dlo, dhi] = FindSearched(lo_px, hi_px);
+  const auto [x0, x1, y0, y1, dlo, dhi, count] = FindSearched(lo_px, hi_px);
   DisparityMap out;
   out.disparity_px = cv::Mat(left.size(), CV_32F, cv::Scalar(std::nanf("")));
   out.confidence = cv::Mat(left.size(), CV_32F, cv::Scalar(0));
@@ -853,14 +856,15 @@ DisparityMap Nl1Matcher::MatchOneWindow(const Nl1Options& options, const cv::Mat
   DisparityMap part;  // views of `out`'s maps: the crop writes into them
   part.disparity_px = out.disparity_px(crop);
   part.confidence = out.confidence(crop);
-  MatchCrop(options, left(crop), right(crop), lo_px(crop), hi_px(crop), &part);
+  MatchCrop(options, left(crop), right(crop), lo_px(crop), hi_px(crop), count, &part);
   part.disparity_px = out.disparity_px;
   part.confidence = out.confidence;
   return part;
 }
 
 void Nl1Matcher::MatchCrop(const Nl1Options& options, const cv::Mat& left, const cv::Mat& right,
-                           const cv::Mat& lo_px, const cv::Mat& hi_px, DisparityMap* result) {
+                           const cv::Mat& lo_px, const cv::Mat& hi_px, int searched,
+                           DisparityMap* result) {
   const int h = options.window_half_px, n = 2 * h + 1;
   DisparityMap& out = *result;
   if (left.rows < n || left.cols < n) return;
@@ -919,7 +923,7 @@ void Nl1Matcher::MatchCrop(const Nl1Options& options, const cv::Mat& left, const
   odd.disparity_px = out.disparity_px;
   odd.confidence = out.confidence;
   std::future<void> other;
-  if (cv::countNonZero(lo_px <= hi_px) >= kThreadedMinPixels)
+  if (searched >= kThreadedMinPixels)
     other = std::async(std::launch::async, match_strips, 1, &odd);
   else
     match_strips(1, &out);

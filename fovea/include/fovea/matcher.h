@@ -66,11 +66,13 @@ class Nl1Matcher : public StereoMatcher {
   std::string Name() const override { return "nl1"; }
 
  private:
-  /// Match on a crop that holds every searched pixel with its window and
-  /// the right columns its band reaches; writes into `out`'s maps (views of
-  /// the crop, initialized) and counts into its counters.
+  /// Match on a crop that holds every searched pixel (`searched` of them:
+  /// lo <= hi) with its window and the right columns its band reaches;
+  /// writes into `out`'s maps (views of the crop, initialized) and counts
+  /// into its counters.
   static void MatchCrop(const Nl1Options& options, const cv::Mat& left, const cv::Mat& right,
-                        const cv::Mat& lo_px, const cv::Mat& hi_px, DisparityMap* out);
+                        const cv::Mat& lo_px, const cv::Mat& hi_px, int searched,
+                        DisparityMap* out);
   /// Match() with one window size, `options`'.
   static DisparityMap MatchOneWindow(const Nl1Options& options, const cv::Mat& left,
                                      const cv::Mat& right, const cv::Mat& lo_px,
