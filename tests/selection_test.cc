@@ -60,6 +60,28 @@ TEST_CASE("each criterion is normalized and says what it should", "[fovea][selec
         Approx(p3d.Evaluate(c).at<double>(60, 120) / o.proximity_3d_low));
 }
 
+TEST_CASE("2D proximity is measured from the gaze when the choice is made in another view",
+          "[fovea][selection]") {
+  fovea::PatchMap map;
+  map.Add(Square(-1, 1, -1, 1, 1.0, fovea::PatchLevel::kIdr));
+  fovea::SelectionContext c = fovea::SelectionContext::Make(HalfTextured(), View(), map);
+  const fovea::CriteriaOptions o;
+  const fovea::Proximity2D p2d(o);
+  cv::Point peak;
+  cv::minMaxLoc(p2d.Evaluate(c), nullptr, nullptr, nullptr, &peak);
+  CHECK(std::abs(peak.x - c.view.intrinsics.cx_px) <= 1);
+  CHECK(std::abs(peak.y - c.view.intrinsics.cy_px) <= 1);
+  // The current fixation point's image in this view, near its top right.
+  c.gaze_px = Eigen::Vector2d(130, 20);
+  const cv::Mat w = p2d.Evaluate(c);
+  cv::minMaxLoc(w, nullptr, nullptr, nullptr, &peak);
+  CHECK(peak == cv::Point(130, 20));
+  CHECK(cv::sum(w)[0] == Approx(1.0));
+  // exp(-r / s): 100 pixels farther from the gaze weigh exp(-100 / s) as much.
+  CHECK(w.at<double>(20, 30) / w.at<double>(20, 130) ==
+        Approx(std::exp(-100.0 / o.proximity_2d_scale_px)));
+}
+
 TEST_CASE("the exponential draw favours high values with the scale asked for",
           "[fovea][selection]") {
   CHECK(fovea::DrawExponential(0.0, 0.5) == 0.0);

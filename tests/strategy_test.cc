@@ -225,7 +225,18 @@ TEST_CASE("selection.strategy names the strategy; deterministic keeps its meanin
     const bool current = std::string(name) == "fovea" || std::string(name) == "deterministic";
     CHECK((s->View() == fovea::StrategyView::kCurrent) == current);
   }
+  for (const char* name : {"fovea", "deterministic"}) {
+    fovea::SelectionOptions o;
+    o.strategy = name;
+    o.view = "reference";
+    REQUIRE_NOTHROW(o.Check());
+    CHECK(fovea::MakeStrategy(o, fovea::CriteriaOptions{})->View() ==
+          fovea::StrategyView::kReference);
+  }
   fovea::SelectionOptions o;
+  o.view = "home";
+  CHECK_THROWS_WITH(o.Check(), Catch::Contains("selection.view"));
+  o.view = "current";
   o.deterministic = true;
   CHECK(fovea::MakeStrategy(o, fovea::CriteriaOptions{})->Name() == "deterministic");
   o.strategy = "random";

@@ -332,6 +332,7 @@ void AddDdrParams(RunConfig* c, std::vector<ConfigParam>* params) {
           {&fp::kSgbmSpeckleRange, &f.sgbm.speckle_range},
           {&fp::kSelectionStrategy, &f.selection.strategy},
           {&fp::kSelectionFirstFixation, &f.selection.first_fixation},
+          {&fp::kSelectionView, &f.selection.view},
           {&fp::kSelectionFoveaSizePx, &f.selection.fovea_size_px},
           {&fp::kSelectionMotionWeight, &f.selection.motion_weight},
           {&fp::kSelectionHalfKnownRelSigma, &f.selection.half_known_rel_sigma},

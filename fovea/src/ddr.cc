@@ -107,6 +107,11 @@ SelectionSummary ChooseTarget(const FoveaRun& run, LoopState& state, FixationStr
     context.z_t_far_m = state.current.z_t_far_m;
     context.visits = state.visits;
     if (options.stay_in_idr_view && !in_reference) context.region = run.idr.final_frame.left;
+    // Chosen in the reference view, 2D proximity is measured from where the
+    // eye looks now: the current fixation point's image there.
+    if (in_reference && state.has_fixation && !state.visits.empty())
+      context.gaze_px = ProjectIntoCamera(view.world_T_camera.inverse(), view.intrinsics,
+                                          state.visits.back().settled_W);
   }
   constexpr int kMaxPrescreened = 8;
   SelectionSummary chosen = strategy.ChooseAccepted(

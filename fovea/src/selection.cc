@@ -208,7 +208,8 @@ cv::Mat LocalSuppression::Evaluate(const SelectionContext& c) const {
 }
 
 cv::Mat Proximity2D::Evaluate(const SelectionContext& c) const {
-  const double cx = c.view.intrinsics.cx_px, cy = c.view.intrinsics.cy_px;
+  const double cx = c.gaze_px ? c.gaze_px->x() : c.view.intrinsics.cx_px;
+  const double cy = c.gaze_px ? c.gaze_px->y() : c.view.intrinsics.cy_px;
   const std::lock_guard<std::mutex> lock(mutex_);
   if (weights_.size() != c.image.size() || cx_ != cx || cy_ != cy) {
     cv::Mat w(c.image.size(), CV_64F);
@@ -240,6 +241,7 @@ cv::Mat Proximity3D::Evaluate(const SelectionContext& c) const {
 void SelectionOptions::Check() const {
   rig::CheckParam(params::kSelectionStrategy, strategy);
   rig::CheckParam(params::kSelectionFirstFixation, first_fixation);
+  rig::CheckParam(params::kSelectionView, view);
   if (deterministic && strategy != "fovea" && strategy != "deterministic")
     throw rig::InputError("key 'selection.deterministic': true applies to strategy fovea, not '" +
                           strategy + "'");

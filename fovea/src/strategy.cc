@@ -10,13 +10,16 @@ namespace fovea {
 namespace {
 
 // The paper's composite rule ("fovea") or its deterministic variant, in the
-// current left view.
+// current left view (or, with selection.view "reference", the reference
+// view).
 class CompositeStrategy : public FixationStrategy {
  public:
   CompositeStrategy(const SelectionOptions& s, const CriteriaOptions& c)
-      : name_(s.Strategy()), selector_(c.Make(), s) {}
+      : name_(s.Strategy()),
+        view_(s.view == "reference" ? StrategyView::kReference : StrategyView::kCurrent),
+        selector_(c.Make(), s) {}
   std::string Name() const override { return name_; }
-  StrategyView View() const override { return StrategyView::kCurrent; }
+  StrategyView View() const override { return view_; }
   SelectionSummary Choose(const SelectionContext& context, const PatchMap& map,
                           const std::vector<Eigen::Vector3d>& refused_W,
                           std::mt19937_64* rng) override {
@@ -38,6 +41,7 @@ class CompositeStrategy : public FixationStrategy {
 
  private:
   std::string name_;
+  StrategyView view_;
   FixationSelector selector_;
   std::optional<FixationSelector::Weights> weights_;  ///< of the last context
 };

@@ -318,6 +318,14 @@ inline constexpr ParamSpec kSelectionFirstFixation{
     "the first fixation: ddr (chosen by the strategy in IDR's final view, as in the paper) or idr "
     "(IDR's well-supported patch nearest the view's centre)",
     0, 0, kSelectionFirstFixations};
+inline constexpr const char* kSelectionViews[] = {"current", "reference", nullptr};
+inline constexpr ParamSpec kSelectionView{
+    "selection.view",
+    "where the composite rules (fovea, deterministic) choose: current (the current left view, as "
+    "in the paper) or reference (IDR's final left view, the region the run maps, with 2D "
+    "proximity measured from the current fixation point's image there); the other strategies "
+    "always choose in the reference view",
+    0, 0, kSelectionViews};
 inline constexpr ParamSpec kSelectionFoveaSizePx{
     "selection.fovea_size_px",
     "the fovea's size in the reference view: raster's cell and next_best_view's window, pixels", 8,

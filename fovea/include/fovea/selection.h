@@ -43,6 +43,11 @@ struct SelectionContext {
     Eigen::Vector3d settled_W, aimed_W;
   };
   std::vector<Visit> visits;
+  /// Where 2D proximity is measured from, in this view's pixels: the
+  /// image's principal point when unset (the current view, whose centre is
+  /// where the eye looks), the current fixation point's image when the
+  /// choice is made in another view.
+  std::optional<Eigen::Vector2d> gaze_px;
   /// If set, only points that this view sees (the IDR view: the region the
   /// run maps) are candidates.
   std::optional<rig::CameraView> region;
@@ -174,6 +179,13 @@ struct SelectionOptions {
   /// final view, as the paper does) or "idr" (IDR's well-supported patch
   /// nearest the view's centre).
   std::string first_fixation = "ddr";
+  /// Where the composite rules choose: "current" (the current left view,
+  /// the paper's) or "reference" (IDR's final left view: the region the run
+  /// maps, fixed from one fixation to the next, so that what is unmapped
+  /// there stays in reach however far the last fixation turned the
+  /// cameras; 2D proximity is then measured from the current fixation
+  /// point's image in it).
+  std::string view = "current";
   double draw_scale = 0.5;  ///< s of the exponential draw
   int histogram_bins = 64;
   int border_px = 16;  ///< candidates keep this far from the image edge
