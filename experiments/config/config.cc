@@ -333,6 +333,7 @@ void AddDdrParams(RunConfig* c, std::vector<ConfigParam>* params) {
           {&fp::kSelectionStrategy, &f.selection.strategy},
           {&fp::kSelectionFirstFixation, &f.selection.first_fixation},
           {&fp::kSelectionView, &f.selection.view},
+          {&fp::kSelectionReferenceFallback, &f.selection.reference_fallback},
           {&fp::kSelectionFoveaSizePx, &f.selection.fovea_size_px},
           {&fp::kSelectionMotionWeight, &f.selection.motion_weight},
           {&fp::kSelectionHalfKnownRelSigma, &f.selection.half_known_rel_sigma},

@@ -27,6 +27,8 @@ nlohmann::json SelectionJson(const fovea::SelectionSummary& s) {
                       {"in_hole", s.in_hole},
                       {"prescreened", s.prescreened}};
   for (const auto& [name, v] : s.criteria) j["criteria_vs_mean"][name] = v;
+  // Only with selection.reference_fallback: the pixel is the reference view's.
+  if (s.in_reference) j["in_reference"] = true;
   return j;
 }
 

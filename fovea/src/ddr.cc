@@ -75,14 +75,41 @@ struct LoopState {
   std::optional<SelectionContext> context;
   std::vector<SelectionContext::Visit> visits;
   std::vector<double> share_history;
+  /// The strategy last weighed the reference view for
+  /// selection.reference_fallback, not `context`.
+  bool weighed_fallback = false;
 };
+
+// The selection context of `view` (reduced `level` times) for the loop's
+// state: the map rendered into it, the current fixation's depth band, the
+// visits; in another view than the current one, 2D proximity is measured
+// from the current fixation point's image there.
+SelectionContext MakeContext(const FoveaRun& run, const LoopState& state,
+                             const rig::CameraView& full_view, bool current_view,
+                             const FoveaOptions& options) {
+  const int level = options.selection.resolution_level;
+  const rig::CameraView view = level > 0 ? ReducedView(full_view, level) : full_view;
+  SelectionContext context = SelectionContext::Make(view.gray, view, run.map, options.fixate_holes);
+  context.eye_W = state.frame.left.world_T_camera;
+  context.has_fixation = state.has_fixation;
+  context.fixation_depth_m = state.current.fixation_depth_m;
+  context.z_t_near_m = state.current.z_t_near_m;
+  context.z_t_far_m = state.current.z_t_far_m;
+  context.visits = state.visits;
+  if (current_view && options.stay_in_idr_view) context.region = run.idr.final_frame.left;
+  if (!current_view && state.has_fixation && !state.visits.empty())
+    context.gaze_px = ProjectIntoCamera(view.world_T_camera.inverse(), view.intrinsics,
+                                        state.visits.back().settled_W);
+  return context;
+}
 
 // The next target: the strategy's choice, in the current view or the
 // reference view as it asks (with selection.first_fixation "idr", IDR's
-// point first). With prescreen_holes, a hole whose window has no unique
-// match along its ray in the pair it was chosen in is passed over without a
-// move (and its neighbourhood with it, as a refused point's), up to
-// kMaxPrescreened times.
+// point first; with selection.reference_fallback, a choice of mapped data in
+// the current view gives way to a hole chosen in the reference view). With
+// prescreen_holes, a hole whose window has no unique match along its ray in
+// the pair it was chosen in is passed over without a move (and its
+// neighbourhood with it, as a refused point's), up to kMaxPrescreened times.
 SelectionSummary ChooseTarget(const FoveaRun& run, LoopState& state, FixationStrategy& strategy,
                               const FoveaOptions& options, const DepthRange& hole_depths,
                               int attempt, std::mt19937_64* rng) {
@@ -94,34 +121,38 @@ SelectionSummary ChooseTarget(const FoveaRun& run, LoopState& state, FixationStr
   }
   const bool in_reference = strategy.View() == StrategyView::kReference;
   const rig::StereoFrame& frame = in_reference ? run.idr.final_frame : state.frame;
-  const bool same_context = state.context.has_value();
+  // The strategy keeps the weights of the context it weighed last: the
+  // loop's context unless the fallback weighed the reference view since.
+  const bool same_context = state.context.has_value() && !state.weighed_fallback;
   const int level = options.selection.resolution_level;
-  if (!same_context) {
-    const rig::CameraView view = level > 0 ? ReducedView(frame.left, level) : frame.left;
-    SelectionContext& context = state.context.emplace(
-        SelectionContext::Make(view.gray, view, run.map, options.fixate_holes));
-    context.eye_W = state.frame.left.world_T_camera;
-    context.has_fixation = state.has_fixation;
-    context.fixation_depth_m = state.current.fixation_depth_m;
-    context.z_t_near_m = state.current.z_t_near_m;
-    context.z_t_far_m = state.current.z_t_far_m;
-    context.visits = state.visits;
-    if (options.stay_in_idr_view && !in_reference) context.region = run.idr.final_frame.left;
-    // Chosen in the reference view, 2D proximity is measured from where the
-    // eye looks now: the current fixation point's image there.
-    if (in_reference && state.has_fixation && !state.visits.empty())
-      context.gaze_px = ProjectIntoCamera(view.world_T_camera.inverse(), view.intrinsics,
-                                          state.visits.back().settled_W);
-  }
+  if (!state.context)
+    state.context.emplace(MakeContext(run, state, frame.left, !in_reference, options));
   constexpr int kMaxPrescreened = 8;
-  SelectionSummary chosen = strategy.ChooseAccepted(
-      *state.context, run.map, &state.refused, rng,
-      [&](const SelectionSummary& s) {
-        return !s.in_hole || !options.prescreen_holes ||
-               UniqueAlongRay(frame, FullResolutionPixel(s.pixel, level), hole_depths,
-                              options.fixation.servo);
-      },
-      kMaxPrescreened, same_context);
+  auto accept_in = [&](const rig::StereoFrame& pair) {
+    return [&](const SelectionSummary& s) {
+      return !s.in_hole || !options.prescreen_holes ||
+             UniqueAlongRay(pair, FullResolutionPixel(s.pixel, level), hole_depths,
+                            options.fixation.servo);
+    };
+  };
+  SelectionSummary chosen =
+      strategy.ChooseAccepted(*state.context, run.map, &state.refused, rng, accept_in(frame),
+                              kMaxPrescreened, same_context);
+  state.weighed_fallback = false;
+  if (options.selection.reference_fallback && !in_reference && state.has_fixation && chosen.ok &&
+      !chosen.in_hole) {
+    const SelectionContext reference =
+        MakeContext(run, state, run.idr.final_frame.left, false, options);
+    std::vector<Eigen::Vector3d> refused = state.refused;
+    const SelectionSummary hole = strategy.ChooseAccepted(
+        reference, run.map, &refused, rng, accept_in(run.idr.final_frame), kMaxPrescreened, false);
+    state.weighed_fallback = true;
+    if (hole.ok && hole.in_hole) {
+      chosen = hole;
+      chosen.in_reference = true;
+      state.refused = std::move(refused);
+    }
+  }
   // The record gives the pixel of the full-resolution view.
   if (chosen.ok) chosen.pixel = FullResolutionPixel(chosen.pixel, level);
   return chosen;

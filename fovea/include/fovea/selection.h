@@ -186,6 +186,12 @@ struct SelectionOptions {
   /// cameras; 2D proximity is then measured from the current fixation
   /// point's image in it).
   std::string view = "current";
+  /// Beyond the paper, for the composite rules in the current view: when
+  /// their choice there is mapped data (not a hole) after the first
+  /// fixation, they choose again in the reference view, and a hole chosen
+  /// there is taken instead (what is unmapped in the region the run maps may
+  /// lie outside the current view).
+  bool reference_fallback = false;
   double draw_scale = 0.5;  ///< s of the exponential draw
   int histogram_bins = 64;
   int border_px = 16;  ///< candidates keep this far from the image edge
@@ -235,8 +241,11 @@ struct SelectionSummary {
   Eigen::Vector2d pixel = Eigen::Vector2d::Zero();
   Eigen::Vector3d point_W = Eigen::Vector3d::Zero();
   bool in_hole = false;  ///< the pixel showed no map data: point_W is a guess
-  int prescreened = 0;   ///< holes passed over before this choice (FoveaOptions::prescreen_holes)
-  int candidates = 0;    ///< pixels with a map point
+  /// Chosen in the reference view by selection.reference_fallback (`pixel`
+  /// is that view's).
+  bool in_reference = false;
+  int prescreened = 0;  ///< holes passed over before this choice (FoveaOptions::prescreen_holes)
+  int candidates = 0;   ///< pixels with a map point
   double composite_max = 0, composite_chosen = 0;
   double drawn_value = 0;  ///< c drawn from the exponential density
   int bin = -1;
