@@ -128,10 +128,12 @@ SelectionSummary ChooseTarget(const FoveaRun& run, LoopState& state, FixationStr
   if (!state.context)
     state.context.emplace(MakeContext(run, state, frame.left, !in_reference, options));
   constexpr int kMaxPrescreened = 8;
-  auto accept_in = [&](const rig::StereoFrame& pair) {
-    return [&](const SelectionSummary& s) {
+  // The prescreen of holes chosen in `pair`'s left view (which outlives the
+  // choice: held by the pointer, not by the parameter's reference).
+  auto accept_in = [&options, &hole_depths, level](const rig::StereoFrame& pair) {
+    return [&options, &hole_depths, level, frame = &pair](const SelectionSummary& s) {
       return !s.in_hole || !options.prescreen_holes ||
-             UniqueAlongRay(pair, FullResolutionPixel(s.pixel, level), hole_depths,
+             UniqueAlongRay(*frame, FullResolutionPixel(s.pixel, level), hole_depths,
                             options.fixation.servo);
     };
   };
