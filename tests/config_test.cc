@@ -144,8 +144,9 @@ TEST_CASE("every parameter of the table: both ends pass, just outside is refused
   }
   CHECK(numbers > 70);
   CHECK(flags > 10);
-  // method, matcher, rig type, nl1.cost, selection strategy, first fixation and view
-  CHECK(choices == 7);
+  // method, matcher, rig type, nl1.cost, selection strategy, first fixation,
+  // view and reference fallback
+  CHECK(choices == 8);
 }
 
 TEST_CASE("the options' own Check() names the YAML key and uses the table's range", "[config]") {

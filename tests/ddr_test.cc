@@ -183,30 +183,36 @@ TEST_CASE("local suppression: without it, fixations revisit mapped places more",
 }
 
 TEST_CASE(
-    "selection.reference_fallback: a choice of mapped data in the current view gives way to a "
-    "hole in the reference view",
+    "selection.reference_fallback: a choice of mapped (or foveal) data in the current view gives "
+    "way to a hole in the reference view",
     "[ddr][slow]") {
-  // two_planes seed 0: the second choice in the current view is mapped
-  // data, and the near plane's unmapped part lies in the reference view.
-  const fs::path with = Out("fallback"), without = Out("nofallback");
-  RunFovea("--scene two_planes --seed 0 --fixations 4 --set selection.reference_fallback=true",
-           with);
-  RunFovea("--scene two_planes --seed 0 --fixations 4", without);
-  const auto rw = Records(with), rn = Records(without);
-  int fallbacks = 0;
-  for (const auto& r : rw) {
-    const json& s = r["selection"];
-    if (!s.contains("in_reference")) continue;
-    ++fallbacks;
-    CHECK(s["in_reference"] == true);
-    CHECK(s["in_hole"] == true);  // only a hole replaces the current view's choice
+  // Each run's first fallback comes at its second attempt, where the
+  // default's choice is mapped data (two_planes seed 0) and foveal data
+  // (random:7 seed 0).
+  for (const auto& [scene, fallback] :
+       {std::pair<std::string, std::string>{"two_planes", "mapped"}, {"random:7", "foveal"}}) {
+    INFO(scene << ", " << fallback);
+    const fs::path with = Out("fallback"), without = Out("nofallback");
+    RunFovea("--scene " + scene +
+                 " --seed 0 --fixations 3 --set selection.reference_fallback=" + fallback,
+             with);
+    RunFovea("--scene " + scene + " --seed 0 --fixations 3", without);
+    const auto rw = Records(with), rn = Records(without);
+    int fallbacks = 0;
+    for (const auto& r : rw) {
+      const json& s = r["selection"];
+      if (!s.contains("in_reference")) continue;
+      ++fallbacks;
+      CHECK(s["in_reference"] == true);
+      CHECK(s["in_hole"] == true);  // only a hole replaces the current view's choice
+    }
+    CHECK(fallbacks >= 1);
+    for (const auto& r : rn) CHECK_FALSE(r["selection"].contains("in_reference"));
+    // Up to the first fallback the two runs chose alike.
+    REQUIRE(rw.size() >= 2);
+    CHECK(WithoutWallClock(rw[0]).dump() == WithoutWallClock(rn[0]).dump());
+    for (const auto& d : {with, without}) fs::remove_all(d);
   }
-  CHECK(fallbacks >= 1);
-  for (const auto& r : rn) CHECK_FALSE(r["selection"].contains("in_reference"));
-  // Up to the first fallback the two runs chose alike.
-  REQUIRE(rw.size() >= 2);
-  CHECK(WithoutWallClock(rw[0]).dump() == WithoutWallClock(rn[0]).dump());
-  for (const auto& d : {with, without}) fs::remove_all(d);
 }
 
 TEST_CASE("a hole's servo search reaches a margin beyond the farthest depth IDR mapped", "[ddr]") {

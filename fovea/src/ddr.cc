@@ -106,7 +106,8 @@ SelectionContext MakeContext(const FoveaRun& run, const LoopState& state,
 // The next target: the strategy's choice, in the current view or the
 // reference view as it asks (with selection.first_fixation "idr", IDR's
 // point first; with selection.reference_fallback, a choice of mapped data in
-// the current view gives way to a hole chosen in the reference view). With
+// the current view, or of foveal data, gives way to a hole chosen in the
+// reference view). With
 // prescreen_holes, a hole whose window has no unique match along its ray in
 // the pair it was chosen in is passed over without a move (and its
 // neighbourhood with it, as a refused point's), up to kMaxPrescreened times.
@@ -141,8 +142,14 @@ SelectionSummary ChooseTarget(const FoveaRun& run, LoopState& state, FixationStr
       strategy.ChooseAccepted(*state.context, run.map, &state.refused, rng, accept_in(frame),
                               kMaxPrescreened, same_context);
   state.weighed_fallback = false;
-  if (options.selection.reference_fallback && !in_reference && state.has_fixation && chosen.ok &&
-      !chosen.in_hole) {
+  const std::string& fallback = options.selection.reference_fallback;
+  auto chose_foveal = [&] {
+    return state.context->map_level.at<signed char>(static_cast<int>(chosen.pixel.y()),
+                                                    static_cast<int>(chosen.pixel.x())) ==
+           static_cast<signed char>(PatchLevel::kFoveal);
+  };
+  if (fallback != "none" && !in_reference && state.has_fixation && chosen.ok && !chosen.in_hole &&
+      (fallback == "mapped" || chose_foveal())) {
     const SelectionContext reference =
         MakeContext(run, state, run.idr.final_frame.left, false, options);
     std::vector<Eigen::Vector3d> refused = state.refused;

@@ -242,6 +242,7 @@ void SelectionOptions::Check() const {
   rig::CheckParam(params::kSelectionStrategy, strategy);
   rig::CheckParam(params::kSelectionFirstFixation, first_fixation);
   rig::CheckParam(params::kSelectionView, view);
+  rig::CheckParam(params::kSelectionReferenceFallback, reference_fallback);
   if (deterministic && strategy != "fovea" && strategy != "deterministic")
     throw rig::InputError("key 'selection.deterministic': true applies to strategy fovea, not '" +
                           strategy + "'");

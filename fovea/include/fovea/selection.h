@@ -187,11 +187,12 @@ struct SelectionOptions {
   /// point's image in it).
   std::string view = "current";
   /// Beyond the paper, for the composite rules in the current view: when
-  /// their choice there is mapped data (not a hole) after the first
-  /// fixation, they choose again in the reference view, and a hole chosen
-  /// there is taken instead (what is unmapped in the region the run maps may
-  /// lie outside the current view).
-  bool reference_fallback = false;
+  /// their choice there after the first fixation is mapped data ("mapped")
+  /// or foveal data ("foveal": the current view holds nothing better), they
+  /// choose again in the reference view, and a hole chosen there is taken
+  /// instead (what is unmapped in the region the run maps may lie outside
+  /// the current view); "none": never.
+  std::string reference_fallback = "none";
   double draw_scale = 0.5;  ///< s of the exponential draw
   int histogram_bins = 64;
   int border_px = 16;  ///< candidates keep this far from the image edge
