@@ -233,6 +233,20 @@ TEST_CASE("selection.strategy names the strategy; deterministic keeps its meanin
     CHECK(fovea::MakeStrategy(o, fovea::CriteriaOptions{})->View() ==
           fovea::StrategyView::kReference);
   }
+  // The fallback replaces a choice in the current view: it names what it
+  // does not apply to instead of doing nothing.
+  for (const char* fallback : {"mapped", "foveal"}) {
+    fovea::SelectionOptions f;
+    f.reference_fallback = fallback;
+    CHECK_NOTHROW(f.Check());
+    f.strategy = "deterministic";
+    CHECK_NOTHROW(f.Check());
+    f.view = "reference";
+    CHECK_THROWS_WITH(f.Check(), Catch::Contains("selection.reference_fallback"));
+    f.view = "current";
+    f.strategy = "next_best_view";
+    CHECK_THROWS_WITH(f.Check(), Catch::Contains("selection.reference_fallback"));
+  }
   fovea::SelectionOptions o;
   o.view = "home";
   CHECK_THROWS_WITH(o.Check(), Catch::Contains("selection.view"));
