@@ -36,8 +36,9 @@ double Texture(double x, double z, std::uint64_t seed, double cell_m) {
          fv * ((1 - fu) * cell(i, j + 1) + fu * cell(i + 1, j + 1));
 }
 
-// A forward-looking camera at X = x_m, its image of the scene.
-rig::CameraView Camera(double x_m) {
+// A forward-looking camera at X = x_m, its image of the scene; the far
+// plane's texture at `far_contrast` of its full contrast about grey 128.
+rig::CameraView Camera(double x_m, double far_contrast = 1) {
   rig::CameraView view = ForwardView(320, 240, 600);
   view.world_T_camera.translation() = Eigen::Vector3d(x_m, 0, 0);
   const rig::CameraIntrinsics& k = view.intrinsics;
@@ -50,8 +51,9 @@ rig::CameraView Camera(double x_m) {
       Eigen::Vector3d p = view.world_T_camera.translation() + d * (kNearY / d.y());
       const bool near = p.x() < 0;
       if (!near) p = view.world_T_camera.translation() + d * (kFarY / d.y());
-      view.gray.at<uchar>(v, u) = cv::saturate_cast<uchar>(near ? Texture(p.x(), p.z(), 1, 0.002)
-                                                                : Texture(p.x(), p.z(), 2, 0.004));
+      view.gray.at<uchar>(v, u) = cv::saturate_cast<uchar>(
+          near ? Texture(p.x(), p.z(), 1, 0.002)
+               : 128 + far_contrast * (Texture(p.x(), p.z(), 2, 0.004) - 128));
     }
   return view;
 }
@@ -170,4 +172,55 @@ TEST_CASE(
   rig::CameraView flat = measured;
   flat.gray.setTo(100);
   CHECK(fovea::HiddenQuarters(patches, flat, reference, check) == std::vector<std::uint8_t>(4, 0));
+}
+
+TEST_CASE(
+    "the strip of a patch's side that the reference camera does not see is cut from its part in "
+    "the reference view, on a faint farther surface too",
+    "[fovea][visibility]") {
+  // The reference camera at X = -1 cm sees the far plane for X > 11.7 mm;
+  // the patch spans X = 7.7 to 31.7 mm of it, so its left 4 mm (a sixth of
+  // its width, about 2 px) lie behind the near plane's edge from there. No
+  // patch has a hidden side.
+  for (const double far_contrast : {1.0, 0.05}) {
+    CAPTURE(far_contrast);
+    const rig::CameraView measured = Camera(0.04, far_contrast),
+                          reference = Camera(-0.01, far_contrast);
+    fovea::PatchMap patches;
+    patches.Add(Square(0.0197, kFarY));  // its left strip hidden from the reference
+    patches.Add(Square(0.05, kFarY));    // the far plane both see
+    patches.Add(Square(-0.05, kNearY));  // the near plane
+    fovea::ReferenceCheckOptions check{0.5, 4};
+    check.side_px = 2;
+    const std::vector<fovea::ReferenceSight> sight =
+        fovea::JudgeReference(patches, measured, reference, check);
+    REQUIRE(sight.size() == 3);
+    for (const fovea::ReferenceSight& s : sight) CHECK_FALSE(fovea::HiddenSide(s.hidden_quarters));
+    // The outer strip (2 px, 1/6 of the patch) is cut, the next one kept.
+    const fovea::Patch::Part& cut = sight[0].part;
+    CHECK(cut.s0 == Approx(1.0 / 6));
+    CHECK(cut.s1 == 1);
+    CHECK(cut.t0 == 0);
+    CHECK(cut.t1 == 1);
+    CHECK(sight[1].part.Whole());
+    CHECK(sight[2].part.Whole());
+    // Without strips the patch is whole.
+    check.side_px = 0;
+    CHECK(fovea::JudgeReference(patches, measured, reference, check)[0].part.Whole());
+    // Marked, the reference view shows the patch from X = 11.7 mm on, on its
+    // plane.
+    check.side_px = 2;
+    fovea::PatchMap marked = patches;
+    CHECK(fovea::MarkHiddenFromReference(&marked, measured, reference, check) == 0);
+    const fovea::PatchMap seen = fovea::ReferenceMap(marked);
+    REQUIRE(seen.size() == 3);
+    for (const Eigen::Vector3d& c : seen[0].corners_W) {
+      CHECK(c.y() == Approx(kFarY));
+      CHECK(std::abs(c.z()) == Approx(0.012));
+    }
+    CHECK(seen[0].corners_W[0].x() == Approx(0.0117).margin(1e-6));
+    CHECK(seen[0].corners_W[3].x() == Approx(0.0117).margin(1e-6));
+    CHECK(seen[0].corners_W[1].x() == Approx(0.0317).margin(1e-6));
+    CHECK(seen[1].corners_W == patches[1].corners_W);
+  }
 }

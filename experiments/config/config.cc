@@ -364,6 +364,7 @@ void AddDdrParams(RunConfig* c, std::vector<ConfigParam>* params) {
           {&fp::kIntegrationRetireInFixationView, &f.integration.retire_in_fixation_view},
           {&fp::kIntegrationReferenceMinNcc, &f.integration.reference_min_ncc},
           {&fp::kIntegrationReferencePooledMinNcc, &f.integration.reference_pooled_min_ncc},
+          {&fp::kIntegrationReferenceSidePx, &f.integration.reference_side_px},
       });
 }
 

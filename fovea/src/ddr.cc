@@ -201,6 +201,7 @@ ReferenceCheckOptions ReferenceCheck(const IntegrationOptions& integration) {
   ReferenceCheckOptions check;
   check.min_ncc = integration.reference_min_ncc;
   check.pooled_min_ncc = integration.reference_pooled_min_ncc;
+  check.side_px = integration.reference_side_px;
   return check;
 }
 

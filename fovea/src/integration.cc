@@ -16,6 +16,7 @@ void IntegrationOptions::Check() const {
   rig::CheckParam(params::kIntegrationContradictionShare, contradiction_share);
   rig::CheckParam(params::kIntegrationReferenceMinNcc, reference_min_ncc);
   rig::CheckParam(params::kIntegrationReferencePooledMinNcc, reference_pooled_min_ncc);
+  rig::CheckParam(params::kIntegrationReferenceSidePx, reference_side_px);
 }
 
 namespace {

@@ -34,6 +34,7 @@ struct NccSums {
     a += x, b += y, aa += x * x, bb += y * y, ab += x * y;
   }
   double VarA() const { return n ? aa / n - (a / n) * (a / n) : 0; }
+  double VarB() const { return n ? bb / n - (b / n) * (b / n) : 0; }
   NccSums& operator+=(const NccSums& o) {
     n += o.n;
     a += o.a, b += o.b, aa += o.aa, bb += o.bb, ab += o.ab;
@@ -49,6 +50,14 @@ struct NccSums {
   /// `min_ncc`: the part they cover is hidden from the reference camera.
   bool Uncorrelated(int tried, double min_var, double min_ncc, int min_n = 0) const {
     return 4 * n >= 3 * tried && n >= min_n && VarA() >= min_var && Ncc() < min_ncc;
+  }
+  /// The same, judged where the samples vary by at least `min_var` in
+  /// either image: a faint surface the reference camera does not see, where
+  /// it sees a textured one in front, is judged too (where it sees the
+  /// faint surface itself, the samples vary little in both).
+  bool UncorrelatedEither(int tried, double min_var, double min_ncc, int min_n) const {
+    return 4 * n >= 3 * tried && n >= min_n && std::max(VarA(), VarB()) >= min_var &&
+           Ncc() < min_ncc;
   }
 };
 
@@ -68,8 +77,19 @@ bool HiddenSide(std::uint8_t quarters) {
 std::vector<std::uint8_t> HiddenQuarters(const PatchMap& patches, const rig::CameraView& measured,
                                          const rig::CameraView& reference,
                                          const ReferenceCheckOptions& options) {
-  std::vector<std::uint8_t> hidden(patches.size(), 0);
-  if (options.min_ncc <= 0) return hidden;
+  ReferenceCheckOptions quarters_only = options;
+  quarters_only.side_px = 0;
+  std::vector<std::uint8_t> hidden;
+  for (const ReferenceSight& s : JudgeReference(patches, measured, reference, quarters_only))
+    hidden.push_back(s.hidden_quarters);
+  return hidden;
+}
+
+std::vector<ReferenceSight> JudgeReference(const PatchMap& patches, const rig::CameraView& measured,
+                                           const rig::CameraView& reference,
+                                           const ReferenceCheckOptions& options) {
+  std::vector<ReferenceSight> sight(patches.size());
+  if (options.min_ncc <= 0) return sight;
   const Eigen::Isometry3d m_T_w = measured.world_T_camera.inverse();
   const Eigen::Isometry3d r_T_w = reference.world_T_camera.inverse();
   const double min_var = options.min_texture_dn * options.min_texture_dn;
@@ -86,6 +106,17 @@ std::vector<std::uint8_t> HiddenQuarters(const PatchMap& patches, const rig::Cam
         if (a && b) side_px = std::max(side_px, (*a - *b).norm());
       }
       const int n = 2 * std::clamp(static_cast<int>(std::lround(side_px / 2)), 2, 16);
+      // Side strips w samples wide (about side_px pixels of the measuring
+      // image), judged from the samples kept per grid point.
+      const int w =
+          options.side_px > 0 && side_px > 0
+              ? std::clamp(static_cast<int>(std::lround(options.side_px * n / side_px)), 1, n / 4)
+              : 0;
+      struct Sample {
+        double m = 0, r = 0;
+        bool ok = false;
+      };
+      std::vector<Sample> samples(w > 0 ? static_cast<size_t>(n) * n : 0);
       std::array<NccSums, 4> quarter;
       std::array<int, 4> tried{0, 0, 0, 0};
       for (int v = 0; v < n; ++v)
@@ -97,11 +128,49 @@ std::vector<std::uint8_t> HiddenQuarters(const PatchMap& patches, const rig::Cam
           const auto pr = ProjectIntoCamera(r_T_w, reference.intrinsics, x);
           if (!pm || !pr) continue;
           const auto gm = SampleGray(measured.gray, *pm), gr = SampleGray(reference.gray, *pr);
-          if (gm && gr) quarter[q].Add(*gm, *gr);
+          if (!gm || !gr) continue;
+          quarter[q].Add(*gm, *gr);
+          if (w > 0) samples[static_cast<size_t>(v) * n + u] = {*gm, *gr, true};
         }
+      std::uint8_t& hidden = sight[i].hidden_quarters;
       for (int q = 0; q < 4; ++q)
         if (quarter[q].Uncorrelated(tried[q], min_var, options.min_ncc))
-          hidden[i] |= std::uint8_t(1u << q);
+          hidden |= std::uint8_t(1u << q);
+      if (w > 0) {
+        // The part kept, in samples: columns [u0, u1), rows [v0, v1). Side
+        // by side (left, right, then top, bottom: the cameras move along
+        // the rail, so occluding edges mostly run up and down), the outer
+        // strip is cut if the reference camera does not see it, then the
+        // next one in if it does not see that either. A strip runs only
+        // along the part left, so that an occluded corner, cut with its
+        // side, does not decide the perpendicular sides.
+        std::array<int, 4> bound{0, n, 0, n};  // u0, u1, v0, v1
+        for (int side = 0; side < 4; ++side)
+          for (int k = 0; k < 2; ++k) {
+            const bool across = side < 2;  // a column of samples, else a row
+            const int lo = across ? bound[2] : bound[0], hi = across ? bound[3] : bound[1];
+            const int edge = bound[side];
+            const int first = side % 2 == 0 ? edge : edge - w;  // the strip's lines
+            NccSums strip;
+            int strip_tried = 0;
+            for (int line = first; line < first + w; ++line)
+              for (int along = lo; along < hi; ++along) {
+                const Sample& x = across ? samples[static_cast<size_t>(along) * n + line]
+                                         : samples[static_cast<size_t>(line) * n + along];
+                ++strip_tried;
+                if (x.ok) strip.Add(x.m, x.r);
+              }
+            if (!strip.UncorrelatedEither(strip_tried, min_var, options.min_ncc,
+                                          ReferenceCheckOptions::kMinSideSamples))
+              break;
+            bound[side] += side % 2 == 0 ? w : -w;
+          }
+        Patch::Part& part = sight[i].part;
+        part.s0 = double(bound[0]) / n;
+        part.s1 = double(bound[1]) / n;
+        part.t0 = double(bound[2]) / n;
+        part.t1 = double(bound[3]) / n;
+      }
       if (options.pooled_min_ncc <= 0) continue;
       // The left and the right column of quarters, then the whole patch.
       const double pooled_min_var = options.pooled_min_texture_dn * options.pooled_min_texture_dn;
@@ -113,26 +182,27 @@ std::vector<std::uint8_t> HiddenQuarters(const PatchMap& patches, const rig::Cam
             sums += quarter[q];
             tried_group += tried[q];
           }
-        if ((hidden[i] & group) != group &&
+        if ((hidden & group) != group &&
             sums.Uncorrelated(tried_group, pooled_min_var, options.pooled_min_ncc,
                               ReferenceCheckOptions::kMinPooledSamples))
-          hidden[i] |= group;
+          hidden |= group;
       }
     }
   };
   constexpr size_t kThreadedMinPatches = 64;
   ForHalves(patches.size(), patches.size() >= kThreadedMinPatches, judge);
-  return hidden;
+  return sight;
 }
 
 int MarkHiddenFromReference(PatchMap* patches, const rig::CameraView& measured,
                             const rig::CameraView& reference,
                             const ReferenceCheckOptions& options) {
-  const std::vector<std::uint8_t> hidden = HiddenQuarters(*patches, measured, reference, options);
+  const std::vector<ReferenceSight> sight = JudgeReference(*patches, measured, reference, options);
   int count = 0;
   for (size_t i = 0; i < patches->size(); ++i) {
-    const bool side = HiddenSide(hidden[i]);
+    const bool side = HiddenSide(sight[i].hidden_quarters);
     patches->SetHiddenInReference(i, side);
+    patches->SetReferencePart(i, sight[i].part);
     count += side;
   }
   return count;
@@ -140,8 +210,19 @@ int MarkHiddenFromReference(PatchMap* patches, const rig::CameraView& measured,
 
 PatchMap ReferenceMap(const PatchMap& map) {
   PatchMap seen;
-  for (const Patch& p : map.patches())
-    if (!p.hidden_in_reference) seen.Add(p);
+  for (const Patch& p : map.patches()) {
+    if (p.hidden_in_reference) continue;
+    const Patch::Part& part = p.reference_part;
+    if (part.Whole()) {
+      seen.Add(p);
+    } else if (part.s0 < part.s1 && part.t0 < part.t1) {
+      // The same plane, cut to the part (bilinear between coplanar corners).
+      Patch cut = p;
+      cut.corners_W = {QuadPoint(p, part.s0, part.t0), QuadPoint(p, part.s1, part.t0),
+                       QuadPoint(p, part.s1, part.t1), QuadPoint(p, part.s0, part.t1)};
+      seen.Add(cut);
+    }
+  }
   return seen;
 }
 

@@ -436,6 +436,13 @@ inline constexpr ParamSpec kIntegrationReferencePooledMinNcc{
     "samples is below this (a faint texture, whose quarters vary too little to be judged on "
     "their own; 0 = quarters only)",
     0, 1};
+inline constexpr ParamSpec kIntegrationReferenceSidePx{
+    "integration.reference_side_px",
+    "beyond the paper: with integration.reference_min_ncc, the strips this many pixels wide along "
+    "a patch's sides (two per side, in the image it was measured in) are judged like its quarters, "
+    "and those the reference camera does not see are cut from its depth in the reference view (a "
+    "farther surface's few pixels past a nearer one's edge; 0 = no strips)",
+    0, 16};
 inline constexpr ParamSpec kLoopFixations{"loop.fixations", "successful fixations to make", 1,
                                           10000};
 inline constexpr ParamSpec kLoopStayInIdrView{

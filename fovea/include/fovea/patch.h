@@ -36,6 +36,16 @@ struct Patch {
   /// map (it is there, and other views see it) but not in the map's depth in
   /// the reference view (ReferenceMap).
   bool hidden_in_reference = false;
+  /// The part of it the reference camera sees, in its coordinates (s, t) in
+  /// [0, 1]^2 across and down its corners (top-left, top-right,
+  /// bottom-right, bottom-left): [s0, s1] x [t0, t1]. Its sides the
+  /// reference camera does not see (ReferenceSides: a strip of a farther
+  /// surface past a nearer one's edge, or a plane carried over an edge) are
+  /// cut from the map's depth in the reference view (ReferenceMap).
+  struct Part {
+    double s0 = 0, s1 = 1, t0 = 0, t1 = 1;
+    bool Whole() const { return s0 <= 0 && s1 >= 1 && t0 <= 0 && t1 >= 1; }
+  } reference_part;
 
   /// Order of precedence between patches of the same surface: foveal over
   /// peripheral over IDR, and within a level the finer resolution first.
@@ -200,6 +210,8 @@ class PatchMap {
   /// Sets patch i's Patch::hidden_in_reference, which no query reads: the
   /// spatial index stays valid.
   void SetHiddenInReference(size_t i, bool hidden) { patches_[i].hidden_in_reference = hidden; }
+  /// Sets patch i's Patch::reference_part, which no query reads either.
+  void SetReferencePart(size_t i, const Patch::Part& part) { patches_[i].reference_part = part; }
   /// Removes the patches whose flag is set (`drop` has one flag per patch);
   /// the others keep their order. Returns how many were removed.
   size_t Remove(const std::vector<char>& drop);

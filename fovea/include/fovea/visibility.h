@@ -40,7 +40,31 @@ struct ReferenceCheckOptions {
   double pooled_min_ncc = 0;
   double pooled_min_texture_dn = 3;
   static constexpr int kMinPooledSamples = 32;
+  /// Beyond the quarters: the strips along each side of a patch, this many
+  /// pixels of the measuring image wide (two per side, one inside the
+  /// other), are judged like a quarter; the outer strip, or both, that the
+  /// reference camera does not see are cut from the patch's part in the
+  /// reference view (Patch::reference_part). A quarter is too coarse for
+  /// the few pixels of a farther surface beside a nearer one's edge. 0: no
+  /// strips.
+  double side_px = 0;
+  /// Samples a strip needs to be judged.
+  static constexpr int kMinSideSamples = 12;
 };
+
+/// What the reference camera sees of one patch (JudgeReference).
+struct ReferenceSight {
+  std::uint8_t hidden_quarters = 0;  ///< as HiddenQuarters
+  Patch::Part part;                  ///< the part its side strips leave
+};
+
+/// Per patch of `patches` (in order), its hidden quarters (HiddenQuarters)
+/// and, with ReferenceCheckOptions::side_px, the part of it left once the
+/// side strips the reference camera does not see are cut off, from one set
+/// of samples. Cost: O(samples).
+std::vector<ReferenceSight> JudgeReference(const PatchMap& patches, const rig::CameraView& measured,
+                                           const rig::CameraView& reference,
+                                           const ReferenceCheckOptions& options);
 
 /// Per patch of `patches` (in order), a bit per quarter (bit 2 v + u for
 /// the quarter u, v in {0, 1} across and down its corners' order) set where
@@ -65,12 +89,14 @@ std::vector<std::uint8_t> HiddenQuarters(const PatchMap& patches, const rig::Cam
 bool HiddenSide(std::uint8_t quarters);
 
 /// Sets Patch::hidden_in_reference on the patches HiddenSide judges hidden
-/// by HiddenQuarters; returns how many.
+/// by HiddenQuarters, and Patch::reference_part on the others
+/// (JudgeReference); returns how many are hidden.
 int MarkHiddenFromReference(PatchMap* patches, const rig::CameraView& measured,
                             const rig::CameraView& reference, const ReferenceCheckOptions& options);
 
 /// The map as the reference view shows it: its patches but those the
-/// reference camera does not see (Patch::hidden_in_reference).
+/// reference camera does not see (Patch::hidden_in_reference), each cut to
+/// its Patch::reference_part.
 PatchMap ReferenceMap(const PatchMap& map);
 
 }  // namespace fovea
