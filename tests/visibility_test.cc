@@ -222,5 +222,12 @@ TEST_CASE(
     CHECK(seen[0].corners_W[3].x() == Approx(0.0117).margin(1e-6));
     CHECK(seen[0].corners_W[1].x() == Approx(0.0317).margin(1e-6));
     CHECK(seen[1].corners_W == patches[1].corners_W);
+    // A patch with every side cut is left out of the reference view.
+    marked.SetReferencePart(1, {0.5, 0.5, 0, 1});
+    CHECK(marked[1].reference_part.Empty());
+    CHECK_FALSE(marked[0].reference_part.Empty());
+    const fovea::PatchMap rest = fovea::ReferenceMap(marked);
+    REQUIRE(rest.size() == 2);
+    CHECK(rest[1].corners_W == patches[2].corners_W);
   }
 }

@@ -200,10 +200,11 @@ int MarkHiddenFromReference(PatchMap* patches, const rig::CameraView& measured,
   const std::vector<ReferenceSight> sight = JudgeReference(*patches, measured, reference, options);
   int count = 0;
   for (size_t i = 0; i < patches->size(); ++i) {
-    const bool side = HiddenSide(sight[i].hidden_quarters);
-    patches->SetHiddenInReference(i, side);
+    // A patch whose every strip is cut is hidden as a whole.
+    const bool hidden = HiddenSide(sight[i].hidden_quarters) || sight[i].part.Empty();
+    patches->SetHiddenInReference(i, hidden);
     patches->SetReferencePart(i, sight[i].part);
-    count += side;
+    count += hidden;
   }
   return count;
 }
@@ -215,7 +216,7 @@ PatchMap ReferenceMap(const PatchMap& map) {
     const Patch::Part& part = p.reference_part;
     if (part.Whole()) {
       seen.Add(p);
-    } else if (part.s0 < part.s1 && part.t0 < part.t1) {
+    } else if (!part.Empty()) {
       // The same plane, cut to the part (bilinear between coplanar corners).
       Patch cut = p;
       cut.corners_W = {QuadPoint(p, part.s0, part.t0), QuadPoint(p, part.s1, part.t0),

@@ -45,6 +45,8 @@ struct Patch {
   struct Part {
     double s0 = 0, s1 = 1, t0 = 0, t1 = 1;
     bool Whole() const { return s0 <= 0 && s1 >= 1 && t0 <= 0 && t1 >= 1; }
+    /// Every side cut away: the reference camera sees none of it.
+    bool Empty() const { return !(s0 < s1 && t0 < t1); }
   } reference_part;
 
   /// Order of precedence between patches of the same surface: foveal over

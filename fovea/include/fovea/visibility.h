@@ -89,7 +89,8 @@ std::vector<std::uint8_t> HiddenQuarters(const PatchMap& patches, const rig::Cam
 bool HiddenSide(std::uint8_t quarters);
 
 /// Sets Patch::hidden_in_reference on the patches HiddenSide judges hidden
-/// by HiddenQuarters, and Patch::reference_part on the others
+/// by HiddenQuarters or whose every side is cut (an empty
+/// Patch::reference_part), and Patch::reference_part on every patch
 /// (JudgeReference); returns how many are hidden.
 int MarkHiddenFromReference(PatchMap* patches, const rig::CameraView& measured,
                             const rig::CameraView& reference, const ReferenceCheckOptions& options);
