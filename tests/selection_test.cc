@@ -269,3 +269,35 @@ TEST_CASE("selection at a reduced resolution: the same rays, sizes in full-resol
   CHECK((ray.origin_W + ray.direction_W * ((s.point_W - ray.origin_W).norm()) - s.point_W).norm() <
         1e-9);
 }
+
+TEST_CASE("staying in the region: no candidate on a patch the reference camera does not see",
+          "[fovea][selection]") {
+  // A wall at 2 m; its right half is a separate patch marked hidden from
+  // the reference camera (a surface seen past a nearer one's edge).
+  fovea::PatchMap map;
+  map.Add(Square(-3, 0, -1, 1, 2.0, fovea::PatchLevel::kFoveal));
+  fovea::Patch hidden = Square(0, 3, -1, 1, 2.0, fovea::PatchLevel::kFoveal);
+  hidden.hidden_in_reference = true;
+  map.Add(hidden);
+  fovea::SelectionContext c = fovea::SelectionContext::Make(HalfTextured(), View(), map);
+  const fovea::SelectionOptions o;  // border 16 px
+  c.region = View();                // the frame alone
+  cv::Mat candidates = fovea::Candidates(c, {}, o);
+  CHECK(candidates.at<uchar>(60, 40) == 255);
+  CHECK(candidates.at<uchar>(60, 120) == 255);
+  c.SetRegion(View(), map);  // and the hidden patches
+  REQUIRE(c.region_hidden.size() == c.map_id.size());
+  candidates = fovea::Candidates(c, {}, o);
+  CHECK(candidates.at<uchar>(60, 40) == 255);
+  CHECK(candidates.at<uchar>(60, 120) == 0);
+  CHECK(cv::countNonZero(candidates(cv::Rect(81, 16, 63, 88))) == 0);
+  // The selector then fixates the half the reference camera sees, though
+  // the texture lies in the other.
+  fovea::SelectionOptions deterministic;
+  deterministic.deterministic = true;
+  const fovea::FixationSelector selector(fovea::CriteriaOptions{}.Make(), deterministic);
+  std::mt19937_64 rng(1);
+  const auto choice = selector.Choose(c, map, {}, &rng);
+  REQUIRE(choice.ok);
+  CHECK(choice.pixel.x() < 80);
+}

@@ -107,14 +107,33 @@ TEST_CASE(
   CHECK(fovea::HiddenQuarters(wrong, measured, reference, check) == std::vector<std::uint8_t>{15});
 }
 
-TEST_CASE("a patch without texture in its measuring image is not judged", "[fovea][visibility]") {
-  rig::CameraView measured = Camera(0.04);
-  const rig::CameraView reference = Camera(-0.01);
+TEST_CASE(
+    "a patch without texture in both images is not judged; without texture where it was "
+    "measured but with texture in the reference image, it is",
+    "[fovea][visibility]") {
+  rig::CameraView measured = Camera(0.04), reference = Camera(-0.01);
   measured.gray.setTo(100);
   fovea::PatchMap patches;
-  patches.Add(Square(-0.025, kFarY));
+  patches.Add(Square(-0.025, kFarY));  // behind the near plane from the reference camera
+  patches.Add(Square(0.05, kFarY));    // the far plane both see
+  // The reference camera sees the near plane's texture where the first
+  // patch lies, and the far plane's where the second does: both are
+  // judged and do not correlate with the flat measuring image.
   CHECK(fovea::HiddenQuarters(patches, measured, reference, {0.5, 4}) ==
-        std::vector<std::uint8_t>{0});
+        std::vector<std::uint8_t>{15, 15});
+  // Flat in both: nothing to judge.
+  reference.gray.setTo(100);
+  CHECK(fovea::HiddenQuarters(patches, measured, reference, {0.5, 4}) ==
+        std::vector<std::uint8_t>{0, 0});
+  // A faint farther surface (a tenth of its contrast, about 5 grey levels)
+  // measured past the nearer one's edge: its quarters vary too little to be
+  // judged from the measuring image, but the reference image shows the
+  // nearer surface's texture there, so they are judged and hidden; where
+  // the reference camera sees the faint surface itself, the samples vary
+  // little in both and pass.
+  const rig::CameraView faint_measured = Camera(0.04, 0.1), faint_reference = Camera(-0.01, 0.1);
+  CHECK(fovea::HiddenQuarters(patches, faint_measured, faint_reference, {0.5, 8}) ==
+        std::vector<std::uint8_t>{15, 0});
 }
 
 TEST_CASE(
@@ -168,33 +187,52 @@ TEST_CASE(
   check.pooled_min_texture_dn = 2.3;
   CHECK(fovea::HiddenQuarters(patches, measured, reference, check) ==
         std::vector<std::uint8_t>{15, 5, 0, 0});
-  // Without texture at all the pooled samples are not judged either.
+  // Without texture in the measuring image, the reference image's faint
+  // texture judges the pooled samples: nothing of it correlates.
   rig::CameraView flat = measured;
   flat.gray.setTo(100);
-  CHECK(fovea::HiddenQuarters(patches, flat, reference, check) == std::vector<std::uint8_t>(4, 0));
+  CHECK(fovea::HiddenQuarters(patches, flat, reference, check) == std::vector<std::uint8_t>(4, 15));
+  // Without texture in either image they are not judged.
+  rig::CameraView flat_reference = reference;
+  flat_reference.gray.setTo(100);
+  CHECK(fovea::HiddenQuarters(patches, flat, flat_reference, check) ==
+        std::vector<std::uint8_t>(4, 0));
 }
 
 TEST_CASE(
     "the strip of a patch's side that the reference camera does not see is cut from its part in "
-    "the reference view, on a faint farther surface too",
+    "the reference view; on a faint farther surface the whole patch is hidden",
     "[fovea][visibility]") {
   // The reference camera at X = -1 cm sees the far plane for X > 11.7 mm;
   // the patch spans X = 7.7 to 31.7 mm of it, so its left 4 mm (a sixth of
-  // its width, about 2 px) lie behind the near plane's edge from there. No
-  // patch has a hidden side.
-  for (const double far_contrast : {1.0, 0.05}) {
-    CAPTURE(far_contrast);
-    const rig::CameraView measured = Camera(0.04, far_contrast),
-                          reference = Camera(-0.01, far_contrast);
-    fovea::PatchMap patches;
-    patches.Add(Square(0.0197, kFarY));  // its left strip hidden from the reference
-    patches.Add(Square(0.05, kFarY));    // the far plane both see
-    patches.Add(Square(-0.05, kNearY));  // the near plane
-    fovea::ReferenceCheckOptions check{0.5, 4};
-    check.side_px = 2;
+  // its width, about 2 px) lie behind the near plane's edge from there.
+  fovea::PatchMap patches;
+  patches.Add(Square(0.0197, kFarY));  // its left strip hidden from the reference
+  patches.Add(Square(0.05, kFarY));    // the far plane both see
+  patches.Add(Square(-0.05, kNearY));  // the near plane
+  fovea::ReferenceCheckOptions check{0.5, 4};
+  check.side_px = 2;
+  {
+    // A faint far plane (5% of its contrast, under 4 grey levels): its
+    // quarters could not be judged from the measuring image, but the left
+    // ones are from the reference image, where a third of each shows the
+    // near plane's texture; they do not correlate, and the patch is hidden
+    // whole rather than cut (judged from the measuring image alone, it
+    // passed, and only its strip was cut). The others pass.
+    const rig::CameraView measured = Camera(0.04, 0.05), reference = Camera(-0.01, 0.05);
     const std::vector<fovea::ReferenceSight> sight =
         fovea::JudgeReference(patches, measured, reference, check);
     REQUIRE(sight.size() == 3);
+    CHECK(sight[0].hidden_quarters == 5);
+    CHECK_FALSE(fovea::HiddenSide(sight[1].hidden_quarters));
+    CHECK_FALSE(fovea::HiddenSide(sight[2].hidden_quarters));
+  }
+  {
+    const rig::CameraView measured = Camera(0.04), reference = Camera(-0.01);
+    const std::vector<fovea::ReferenceSight> sight =
+        fovea::JudgeReference(patches, measured, reference, check);
+    REQUIRE(sight.size() == 3);
+    // No patch has a hidden side.
     for (const fovea::ReferenceSight& s : sight) CHECK_FALSE(fovea::HiddenSide(s.hidden_quarters));
     // The outer strip (2 px, 1/6 of the patch) is cut, the next one kept.
     const fovea::Patch::Part& cut = sight[0].part;

@@ -96,7 +96,8 @@ SelectionContext MakeContext(const FoveaRun& run, const LoopState& state,
   context.z_t_near_m = state.current.z_t_near_m;
   context.z_t_far_m = state.current.z_t_far_m;
   context.visits = state.visits;
-  if (current_view && options.stay_in_idr_view) context.region = run.idr.final_frame.left;
+  if (current_view && options.stay_in_idr_view)
+    context.SetRegion(run.idr.final_frame.left, run.map);
   if (!current_view && state.has_fixation && !state.visits.empty())
     context.gaze_px = ProjectIntoCamera(view.world_T_camera.inverse(), view.intrinsics,
                                         state.visits.back().settled_W);

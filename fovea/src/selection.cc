@@ -107,6 +107,16 @@ cv::Mat GradientAttraction::Evaluate(const SelectionContext& c) const {
   return w;
 }
 
+void SelectionContext::SetRegion(const rig::CameraView& region_view, const PatchMap& map) {
+  region = region_view;
+  region_hidden = cv::Mat(map_id.size(), CV_8U, cv::Scalar(0));
+  for (int y = 0; y < map_id.rows; ++y) {
+    const int* id = map_id.ptr<int>(y);
+    uchar* hidden = region_hidden.ptr<uchar>(y);
+    for (int x = 0; x < map_id.cols; ++x) hidden[x] = id[x] >= 0 && map[id[x]].hidden_in_reference;
+  }
+}
+
 Eigen::Vector3d SelectionContext::MapPoint(int x, int y) const {
   if (!map_points_W.empty()) {
     const cv::Vec3d& p = map_points_W.at<cv::Vec3d>(y, x);
@@ -301,6 +311,7 @@ cv::Mat Candidates(const SelectionContext& c, const std::vector<Eigen::Vector3d>
     for (int x = b; x < candidates.cols - b; ++x) {
       if (!(depth[x] > 0)) continue;
       if (c.region) {
+        if (!c.region_hidden.empty() && c.region_hidden.at<uchar>(y, x)) continue;
         const auto& k = c.region->intrinsics;
         const auto uv = ProjectIntoCamera(region_T_world, k, c.MapPoint(x, y));
         if (!uv || uv->x() < b || uv->y() < b || uv->x() > k.width_px - 1 - b ||

@@ -46,16 +46,12 @@ struct NccSums {
   }
   /// Whether these samples, of `tried` sample points, are judged (at least
   /// 3/4 of them fell inside both images, at least `min_n` in all, and they
-  /// vary by at least `min_var` in the measuring image) and correlate below
-  /// `min_ncc`: the part they cover is hidden from the reference camera.
+  /// vary by at least `min_var` in either image) and correlate below
+  /// `min_ncc`: the part they cover is hidden from the reference camera. A
+  /// faint surface the reference camera does not see, where it sees a
+  /// textured one in front, is judged too; where it sees the faint surface
+  /// itself, the samples vary little in both.
   bool Uncorrelated(int tried, double min_var, double min_ncc, int min_n = 0) const {
-    return 4 * n >= 3 * tried && n >= min_n && VarA() >= min_var && Ncc() < min_ncc;
-  }
-  /// The same, judged where the samples vary by at least `min_var` in
-  /// either image: a faint surface the reference camera does not see, where
-  /// it sees a textured one in front, is judged too (where it sees the
-  /// faint surface itself, the samples vary little in both).
-  bool UncorrelatedEither(int tried, double min_var, double min_ncc, int min_n) const {
     return 4 * n >= 3 * tried && n >= min_n && std::max(VarA(), VarB()) >= min_var &&
            Ncc() < min_ncc;
   }
@@ -160,8 +156,8 @@ std::vector<ReferenceSight> JudgeReference(const PatchMap& patches, const rig::C
                 ++strip_tried;
                 if (x.ok) strip.Add(x.m, x.r);
               }
-            if (!strip.UncorrelatedEither(strip_tried, min_var, options.min_ncc,
-                                          ReferenceCheckOptions::kMinSideSamples))
+            if (!strip.Uncorrelated(strip_tried, min_var, options.min_ncc,
+                                    ReferenceCheckOptions::kMinSideSamples))
               break;
             bound[side] += side % 2 == 0 ? w : -w;
           }

@@ -30,7 +30,9 @@ struct FoveaOptions {
   CriteriaOptions criteria;
   IntegrationOptions integration;
   int fixations = 25;  ///< successful fixations to make
-  /// Fixate only points inside the IDR view: the region the run maps.
+  /// Fixate only points inside the IDR view: the region the run maps; and,
+  /// with a reference view, none on a patch it does not see
+  /// (SelectionContext::region_hidden).
   bool stay_in_idr_view = true;
   /// Beyond the paper: pixels the map is silent at are fixation candidates
   /// too, at the depth of the nearest mapped pixel (SelectionContext::Make).

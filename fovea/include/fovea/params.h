@@ -446,7 +446,10 @@ inline constexpr ParamSpec kIntegrationReferenceSidePx{
 inline constexpr ParamSpec kLoopFixations{"loop.fixations", "successful fixations to make", 1,
                                           10000};
 inline constexpr ParamSpec kLoopStayInIdrView{
-    "loop.stay_in_idr_view", "fixate only points inside the IDR view (the region the run maps)"};
+    "loop.stay_in_idr_view",
+    "fixate only points inside the IDR view (the region the run maps), and, with "
+    "integration.reference_min_ncc, none on a patch the reference camera does not see (a surface "
+    "seen past a nearer one's edge from where the rig stands)"};
 inline constexpr ParamSpec kLoopFixateHoles{"loop.fixate_holes",
                                             "beyond the paper: pixels the map is silent at are "
                                             "candidates, at the depth of the nearest mapped pixel "

@@ -51,6 +51,16 @@ struct SelectionContext {
   /// If set, only points that this view sees (the IDR view: the region the
   /// run maps) are candidates.
   std::optional<rig::CameraView> region;
+  /// CV_8U, this view's size (SetRegion makes it): non-zero where the
+  /// patch seen is one the reference camera does not see
+  /// (Patch::hidden_in_reference: a surface seen past a nearer one's edge
+  /// from where the rig stands now). No candidate: a fixation there maps
+  /// nothing the run's view shows. Empty: no such test.
+  cv::Mat region_hidden;
+
+  /// Sets `region` to `region_view` and region_hidden from `map` (the one
+  /// this context was made of: map_id indexes it).
+  void SetRegion(const rig::CameraView& region_view, const PatchMap& map);
 
   /// MapPoint at every pixel with map_depth_m > 0 (CV_64FC3, world
   /// frame), made once by Make: local suppression and the refused points
@@ -265,8 +275,9 @@ double UniformDraw(std::mt19937_64* rng);
 
 /// The pixels a strategy may choose (CV_8U, 255 = candidate): those the map
 /// can raytrace (map_depth_m > 0, filled holes included), at least
-/// `options.border_px` from the edge, inside `context.region` if it is set,
-/// and farther than `options.refused_radius_m` from every refused point.
+/// `options.border_px` from the edge, inside `context.region` if it is set
+/// and not on a patch context.region_hidden marks, and farther than `options.refused_radius_m` from
+/// every refused point.
 cv::Mat Candidates(const SelectionContext& context, const std::vector<Eigen::Vector3d>& refused_W,
                    const SelectionOptions& options);
 

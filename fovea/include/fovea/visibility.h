@@ -26,8 +26,11 @@ struct ReferenceCheckOptions {
   /// measured in and in the reference image (both sampled at the same points
   /// of its plane) is below this. 0: no check.
   double min_ncc = 0;
-  /// A quarter whose samples in the measuring image vary less than this
-  /// (standard deviation, grey levels) cannot be judged and passes.
+  /// A quarter whose samples vary less than this (standard deviation, grey
+  /// levels) in both images cannot be judged and passes. Where only the
+  /// reference image's vary, the reference camera sees another surface (a
+  /// faint farther one hidden behind a textured nearer one) and the quarter
+  /// is judged.
   double min_texture_dn = 4;
   /// Beyond the quarters: the samples of each half across the patch (its
   /// left and its right column of quarters) and of the whole patch, pooled,
