@@ -187,13 +187,14 @@ TEST_CASE(
     "way to a hole in the reference view",
     "[ddr][slow]") {
   // Each run's first fallback comes at its second attempt, where the
-  // default's choice is mapped data (two_planes seed 1) and foveal data
-  // (random:7 seed 0).
+  // default's choice is mapped data (random:4 seed 0) and foveal data
+  // (random:7 seed 0), in the release and the sanitizer builds alike
+  // (measured; two_planes seed 1 falls back in one and not the other).
   struct Case {
     std::string scene, seed, fallback;
   };
   for (const auto& [scene, seed, fallback] :
-       {Case{"two_planes", "1", "mapped"}, Case{"random:7", "0", "foveal"}}) {
+       {Case{"random:4", "0", "mapped"}, Case{"random:7", "0", "foveal"}}) {
     INFO(scene << " seed " << seed << ", " << fallback);
     const fs::path with = Out("fallback"), without = Out("nofallback");
     RunFovea("--scene " + scene + " --seed " + seed +
