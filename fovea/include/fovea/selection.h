@@ -276,8 +276,8 @@ double UniformDraw(std::mt19937_64* rng);
 /// The pixels a strategy may choose (CV_8U, 255 = candidate): those the map
 /// can raytrace (map_depth_m > 0, filled holes included), at least
 /// `options.border_px` from the edge, inside `context.region` if it is set
-/// and not on a patch context.region_hidden marks, and farther than `options.refused_radius_m` from
-/// every refused point.
+/// and not on a patch context.region_hidden marks, and farther than
+/// `options.refused_radius_m` from every refused point.
 cv::Mat Candidates(const SelectionContext& context, const std::vector<Eigen::Vector3d>& refused_W,
                    const SelectionOptions& options);
 
