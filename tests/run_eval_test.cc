@@ -100,6 +100,28 @@ TEST_CASE("map score: the pixels near edges are split by the source of the patch
                              j["edge_bad_nearer_share"].get<double>())
                           .epsilon(1e-9));
   CHECK(j["edge_bad_nearer_share"].get<double>() > 0);  // the quads before the back plane
+
+  // Coverage beside the edges: of the textured pixels near an edge, those
+  // mapped (the IDR quad spans the view: all of them), and those mapped
+  // right.
+  const long edge_visible = cv::countNonZero(ref.near_edge & ref.textured);
+  REQUIRE(edge_visible > 0);
+  CHECK(j["edge_visible_pixels"].get<long>() == edge_visible);
+  CHECK(j["edge_coverage"].get<double>() == Approx(double(edge_pixels) / edge_visible));
+  CHECK(j["edge_coverage"].get<double>() > 0.99);
+  CHECK(j["edge_good_coverage"].get<double>() ==
+        Approx(edge_pixels * (1 - j["edge_bad_share"].get<double>()) / edge_visible));
+  CHECK(j["edge_good_coverage"].get<double>() < j["edge_coverage"].get<double>());
+  // An empty map covers none of them; a view with no edge has no such share.
+  const nlohmann::json empty = experiments::ScoreJson(
+      experiments::ScoreMap(fovea::PatchMap(), ref, sim->truth(), 0.06, false));
+  CHECK(empty["edge_visible_pixels"].get<long>() == edge_visible);
+  CHECK(empty["edge_coverage"].get<double>() == 0);
+  CHECK(empty["edge_good_coverage"].get<double>() == 0);
+  CHECK(empty["edge_bad_share"].is_null());
+  const nlohmann::json flat = experiments::ScoreJson(experiments::MapScore());
+  CHECK(flat["edge_coverage"].is_null());
+  CHECK(flat["edge_good_coverage"].is_null());
 }
 
 TEST_CASE("error picture: right pixels green, too near red, too far magenta, true edges blue",

@@ -343,6 +343,7 @@ std::string SceneTable(const std::vector<SweepRow>& rows) {
       {"good_coverage", "good coverage (within 1%)"},
       {"bad_share", "bad share"},
       {"edge_bad_share", "bad share near edges"},
+      {"edge_good_coverage", "good coverage near edges"},
       {"median_abs_error_m", "median |error|, mm"},
       {"median_rel_error", "median rel. error, %"},
       {"rmse_m", "RMSE, mm"},

@@ -333,7 +333,7 @@ MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref,
   std::map<int, PerSurface> surfaces;
   int last_geom = 0;
   PerSurface* last = nullptr;  // surfaces[last_geom]: neighbours mostly share a surface
-  long mapped = 0, foveal = 0, mapped_stereo_visible = 0;
+  long mapped = 0, foveal = 0, mapped_stereo_visible = 0, edge_visible = 0;
   all.abs.reserve(ref.textured_pixels);
   all.rel.reserve(ref.textured_pixels);
   all.steps.reserve(ref.textured_pixels);
@@ -350,6 +350,8 @@ MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref,
       ++ps.pixels;
       const bool paired = ref.stereo_visible.at<uchar>(y, x);
       ps.stereo_visible += paired;
+      const bool near_edge = ref.near_edge.at<uchar>(y, x);
+      edge_visible += near_edge;
       const int id = ids.at<int>(y, x);
       if (id < 0 || zt <= 0) continue;
       mapped_stereo_visible += paired;
@@ -360,7 +362,6 @@ MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref,
       if (lv == static_cast<int>(fovea::PatchLevel::kFoveal)) ++foveal, ++ps.foveal;
       const double step = zt * zt / (f * baseline_m);
       all.Add(z, zt, step);
-      const bool near_edge = ref.near_edge.at<uchar>(y, x);
       if (near_edge) edges.Add(z, zt, step);
       level[lv].Add(z, zt, step);
       if (map[id].level == fovea::PatchLevel::kIdr) {
@@ -381,6 +382,11 @@ MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref,
   s.overall = all.Figures(total);
   s.good_coverage = total ? double(s.overall.pixels - s.overall.bad) / total : 0;
   s.near_edges = edges.Figures(total);
+  s.edge_visible_pixels = edge_visible;
+  if (edge_visible > 0) {
+    s.edge_coverage = double(s.near_edges.pixels) / edge_visible;
+    s.edge_good_coverage = double(s.near_edges.pixels - s.near_edges.bad) / edge_visible;
+  }
   s.near_edges_idr = edges_idr.Figures(total);
   for (int i = 0; i < 6; ++i) s.near_edges_by_resolution[i] = edges_resolution[i].Figures(total);
   for (int i = 0; i < 3; ++i) s.by_level[i] = level[i].Figures(total);
@@ -489,6 +495,10 @@ nlohmann::json ScoreJson(const MapScore& s) {
   j["bad_share"] = BadShare(s.overall);
   j["edge_bad_share"] = BadShare(s.near_edges);
   j["edge_pixels"] = s.near_edges.pixels;
+  // Null where the view holds no pixel beside a depth edge.
+  j["edge_visible_pixels"] = s.edge_visible_pixels;
+  j["edge_coverage"] = Figure(s.edge_visible_pixels, s.edge_coverage);
+  j["edge_good_coverage"] = Figure(s.edge_visible_pixels, s.edge_good_coverage);
   // Where the pixels near edges come from: IDR, or a resolution level.
   j["edge_bad_nearer_share"] = BadNearerShare(s.near_edges);
   j["edge_by_source"]["idr"] = BadJson(s.near_edges_idr);

@@ -98,6 +98,12 @@ struct MapScore {
   double good_coverage = 0;
   /// The mapped pixels within kEdgeRadiusPx of a depth discontinuity.
   ErrorFigures near_edges;
+  /// The visible textured pixels within kEdgeRadiusPx of a depth
+  /// discontinuity, and the shares of them the map holds (edge_coverage)
+  /// and holds within kBadShare of their depth (edge_good_coverage): where
+  /// the coverage beside edges goes (0 when there are none).
+  long edge_visible_pixels = 0;
+  double edge_coverage = 0, edge_good_coverage = 0;
   /// The same pixels by the patch seen: IDR, or the resolution level of a
   /// foveal or peripheral patch (where the bleeding across edges comes from).
   ErrorFigures near_edges_idr;
