@@ -466,15 +466,11 @@ void PatchMap::Render(const Eigen::Isometry3d& world_T_camera, const rig::Camera
         const int v1 =
             std::min(drawn.y + drawn.height - 1,
                      static_cast<int>(std::floor(std::max({uv[0].y(), uv[1].y(), uv[2].y()}))));
-        // Inside, each edge function times the area is at least -1e-9 area^2
-        // (the test's tolerance); far wider here, so that no rounding excludes
-        // a column the test would take.
-        const double tolerance = 1e-6 * (area * area + 1);
-        // The barycentric weights w0 (of uv[0]) and w1 are affine in the
-        // pixel, w = du u + dv v + c, and 1/z is affine in them: per pixel
-        // three products and one division. Each pixel's two edge functions
-        // and three divisions took 1.2 times as long for the whole render
-        // (6000 small patches over a 640 x 480 view).
+        // The barycentric weights w0, w1, w2 (of uv[0], uv[1], uv[2]) are
+        // affine in the pixel, w = du u + dv v + c, and 1/z is affine in them:
+        // per pixel three products and one division. Each pixel's two edge
+        // functions and three divisions took 1.2 times as long for the whole
+        // render (6000 small patches over a 640 x 480 view).
         struct Affine {
           double du, dv, c;
         };
@@ -484,7 +480,11 @@ void PatchMap::Render(const Eigen::Isometry3d& world_T_camera, const rig::Camera
           const Eigen::Vector2d e = b - a;
           return Affine{-e.y() / area, e.x() / area, (e.y() * a.x() - e.x() * a.y()) / area};
         };
-        const Affine f0 = weight(uv[1], uv[2]), f1 = weight(uv[2], uv[0]);
+        const std::array<Affine, 3> f = {weight(uv[1], uv[2]), weight(uv[2], uv[0]),
+                                         weight(uv[0], uv[1])};
+        // Inside, each weight is at least -1e-9 (the test's tolerance); far
+        // wider here, so that no rounding excludes a column the test would take.
+        const double tolerance = 1e-6 * (1 + 1 / (area * area));
         const double iz0 = inv_z[0] - inv_z[2], iz1 = inv_z[1] - inv_z[2];
         float* const depth_rows = depth.ptr<float>(0);
         int* const id_rows = ids.ptr<int>(0);
@@ -495,16 +495,13 @@ void PatchMap::Render(const Eigen::Isometry3d& world_T_camera, const rig::Camera
             continue;
           }
           // The row's columns inside the triangle, with a pixel to spare
-          // either side: only they are tested below, which decides. Each edge
-          // function times the area is affine along the row: slope * u + offset.
+          // either side: only they are tested below, which decides. Along the
+          // row each weight is du * u + offset.
           double lo = u0 - 1, hi = u1 + 1;
-          for (int e = 0; e < 3; ++e) {
-            const Eigen::Vector2d &a = uv[(e + 1) % 3], &b = uv[(e + 2) % 3];
-            const double slope = -(b - a).y() * area,
-                         offset =
-                             ((b - a).x() * (v - a.y()) + (b - a).y() * a.x()) * area + tolerance;
-            if (slope > 0) lo = std::max(lo, -offset / slope);
-            if (slope < 0) hi = std::min(hi, -offset / slope);
+          for (const Affine& w : f) {
+            const double offset = w.dv * v + w.c + tolerance;
+            if (w.du > 0) lo = std::max(lo, -offset / w.du);
+            if (w.du < 0) hi = std::min(hi, -offset / w.du);
           }
           // Both bounds within [u0 - 1, u1 + 1] before the conversion (a
           // sliver's edge can put one far beyond the image).
@@ -512,11 +509,11 @@ void PatchMap::Render(const Eigen::Isometry3d& world_T_camera, const rig::Camera
               std::max(u0, static_cast<int>(std::floor(std::clamp(lo, u0 - 1.0, u1 + 1.0))) - 1);
           const int last =
               std::min(u1, static_cast<int>(std::ceil(std::clamp(hi, u0 - 1.0, u1 + 1.0))) + 1);
-          const double r0 = f0.dv * v + f0.c, r1 = f1.dv * v + f1.c;
+          const double r0 = f[0].dv * v + f[0].c, r1 = f[1].dv * v + f[1].c;
           float* const depth_row = depth_rows + static_cast<size_t>(v) * k.width_px;
           int* const id_row = id_rows + static_cast<size_t>(v) * k.width_px;
           for (int u = first; u <= last; ++u) {
-            const double w0 = f0.du * u + r0, w1 = f1.du * u + r1;
+            const double w0 = f[0].du * u + r0, w1 = f[1].du * u + r1;
             const double w2 = 1 - w0 - w1;
             if (w0 < -1e-9 || w1 < -1e-9 || w2 < -1e-9) continue;
             const double z = 1.0 / (inv_z[2] + w0 * iz0 + w1 * iz1);
