@@ -235,7 +235,7 @@ TEST_CASE("selection.strategy names the strategy; deterministic keeps its meanin
   }
   // The fallback replaces a choice in the current view: it names what it
   // does not apply to instead of doing nothing.
-  for (const char* fallback : {"mapped", "foveal"}) {
+  for (const char* fallback : {"mapped", "foveal", "stalled"}) {
     fovea::SelectionOptions f;
     f.reference_fallback = fallback;
     CHECK_NOTHROW(f.Check());

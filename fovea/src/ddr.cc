@@ -14,17 +14,24 @@
 namespace fovea {
 namespace {
 
-// Share of the view's pixels where the map shows foveal data.
-double FovealShare(const PatchMap& map, const rig::CameraView& view) {
+struct ViewShares {
+  double mapped = 0, foveal = 0;
+};
+
+// The shares of `view`'s pixels where the map shows a patch, and a foveal one.
+ViewShares MapShares(const PatchMap& map, const rig::CameraView& view) {
   cv::Mat ids;
   map.Render(view.world_T_camera, view.intrinsics, nullptr, &ids);
-  long foveal = 0;
+  long mapped = 0, foveal = 0;
   for (int y = 0; y < ids.rows; ++y)
     for (int x = 0; x < ids.cols; ++x) {
       const int id = ids.at<int>(y, x);
-      if (id >= 0 && map[id].level == PatchLevel::kFoveal) ++foveal;
+      if (id < 0) continue;
+      ++mapped;
+      if (map[id].level == PatchLevel::kFoveal) ++foveal;
     }
-  return ids.total() ? double(foveal) / double(ids.total()) : 0.0;
+  if (ids.total() == 0) return {};
+  return {double(mapped) / double(ids.total()), double(foveal) / double(ids.total())};
 }
 
 }  // namespace
@@ -78,6 +85,11 @@ struct LoopState {
   /// The strategy last weighed the reference view for
   /// selection.reference_fallback, not `context`.
   bool weighed_fallback = false;
+  /// The map's share of the IDR view after the last fixation, and whether
+  /// that fixation raised it by less than SelectionOptions::kStalledGrowth
+  /// (reference_fallback "stalled").
+  double mapped_share = 0;
+  bool stalled = false;
 };
 
 // The selection context of `view` (reduced `level` times) for the loop's
@@ -107,9 +119,9 @@ SelectionContext MakeContext(const FoveaRun& run, const LoopState& state,
 // The next target: the strategy's choice, in the current view or the
 // reference view as it asks (with selection.first_fixation "idr", IDR's
 // point first; with selection.reference_fallback, a choice of mapped data in
-// the current view, or of foveal data, gives way to a hole chosen in the
-// reference view). With prescreen_holes, a hole whose window has no unique
-// match along its ray in the pair it was chosen in is passed over without a
+// the current view, of foveal data, or of mapped data after a stalled
+// fixation, gives way to a hole chosen in the reference view). With prescreen_holes, a hole whose
+// window has no unique match along its ray in the pair it was chosen in is passed over without a
 // move (and its neighbourhood with it, as a refused point's), up to
 // kMaxPrescreened times.
 SelectionSummary ChooseTarget(const FoveaRun& run, LoopState& state, FixationStrategy& strategy,
@@ -150,7 +162,7 @@ SelectionSummary ChooseTarget(const FoveaRun& run, LoopState& state, FixationStr
            static_cast<signed char>(PatchLevel::kFoveal);
   };
   if (fallback != "none" && !in_reference && state.has_fixation && chosen.ok && !chosen.in_hole &&
-      (fallback == "mapped" || chose_foveal())) {
+      (fallback == "mapped" || (fallback == "stalled" ? state.stalled : chose_foveal()))) {
     const SelectionContext reference =
         MakeContext(run, state, run.idr.final_frame.left, false, options);
     std::vector<Eigen::Vector3d> refused = state.refused;
@@ -209,8 +221,8 @@ ReferenceCheckOptions ReferenceCheck(const IntegrationOptions& integration) {
 // Merges a fixation's patches into the map (timed as integration) and moves
 // the loop on to the fixation's view.
 void Absorb(const FixationResult& r, const rig::CameraView& idr_view,
-            const rig::CameraView* reference, const IntegrationOptions& integration,
-            int stall_fixations, FoveaRun* run, LoopState* state, FixationRecord* rec) {
+            const rig::CameraView* reference, const IntegrationOptions& integration, bool shares,
+            FoveaRun* run, LoopState* state, FixationRecord* rec) {
   const auto t = Clock::now();
   state->frame = r.servo.frame;
   PatchMap fresh = r.foveal.patches;
@@ -230,8 +242,15 @@ void Absorb(const FixationResult& r, const rig::CameraView& idr_view,
   run->map.BuildIndex();
   rec->time.integrate_s = Since(t);
   rec->map_by_level = run->map.CountByLevel();
-  // Only the stall rule reads it: a render of the whole map per fixation.
-  if (stall_fixations > 0) rec->foveal_share = FovealShare(run->map, idr_view);
+  // Only the stall rule and the stalled fallback read them: a render of the
+  // whole map per fixation.
+  if (shares) {
+    const ViewShares s = MapShares(run->map, idr_view);
+    rec->foveal_share = s.foveal;
+    rec->mapped_share = s.mapped;
+    state->stalled = s.mapped - state->mapped_share < SelectionOptions::kStalledGrowth;
+    state->mapped_share = s.mapped;
+  }
   state->has_fixation = true;
   state->context.reset();
   state->visits.push_back({rec->fixation_W, rec->target_W});
@@ -348,7 +367,8 @@ FoveaRun RunFovea(rig::Rig& rig, const StereoMatcher& matcher, const FoveaOption
     rec.fixation = ++run.fixations_done;
     RecordFixation(r, &rec);
     Absorb(r, idr_view, reference ? &*reference : nullptr, options.integration,
-           options.stall_fixations, &run, &state, &rec);
+           options.stall_fixations > 0 || options.selection.reference_fallback == "stalled", &run,
+           &state, &rec);
     record(rec);
     state.share_history.push_back(rec.foveal_share);
     if (Stalled(state.share_history, options)) {

@@ -326,12 +326,14 @@ inline constexpr ParamSpec kSelectionView{
     "proximity measured from the current fixation point's image there); the other strategies "
     "always choose in the reference view",
     0, 0, kSelectionViews};
-inline constexpr const char* kSelectionReferenceFallbacks[] = {"none", "mapped", "foveal", nullptr};
+inline constexpr const char* kSelectionReferenceFallbacks[] = {"none", "mapped", "foveal",
+                                                               "stalled", nullptr};
 inline constexpr ParamSpec kSelectionReferenceFallback{
     "selection.reference_fallback",
     "beyond the paper: when the composite rule's choice in the current view is mapped data "
-    "(mapped) or foveal data (foveal), it chooses again in the reference view and takes a hole "
-    "chosen there instead (none: never)",
+    "(mapped), foveal data (foveal), or mapped data after a fixation that raised the map's share "
+    "of the reference view by less than 0.002 (stalled), it chooses again in the reference view "
+    "and takes a hole chosen there instead (none: never)",
     0, 0, kSelectionReferenceFallbacks};
 inline constexpr ParamSpec kSelectionFoveaSizePx{
     "selection.fovea_size_px",

@@ -197,12 +197,17 @@ struct SelectionOptions {
   /// point's image in it).
   std::string view = "current";
   /// Beyond the paper, for the composite rules in the current view: when
-  /// their choice there after the first fixation is mapped data ("mapped")
-  /// or foveal data ("foveal": the current view holds nothing better), they
-  /// choose again in the reference view, and a hole chosen there is taken
-  /// instead (what is unmapped in the region the run maps may lie outside
-  /// the current view); "none": never.
+  /// their choice there after the first fixation is mapped data ("mapped"),
+  /// foveal data ("foveal": the current view holds nothing better), or
+  /// mapped data after a fixation that raised the map's share of the
+  /// reference view by less than kStalledGrowth ("stalled": the current view
+  /// has stopped paying), they choose again in the reference view, and a
+  /// hole chosen there is taken instead (what is unmapped in the region the
+  /// run maps may lie outside the current view); "none": never.
   std::string reference_fallback = "none";
+  /// reference_fallback "stalled": a fixation that raised the map's share of
+  /// the reference view by less than this (a share of its pixels) stalled.
+  static constexpr double kStalledGrowth = 0.002;
   double draw_scale = 0.5;  ///< s of the exponential draw
   int histogram_bins = 64;
   int border_px = 16;  ///< candidates keep this far from the image edge
