@@ -247,7 +247,6 @@ void Absorb(const FixationResult& r, const rig::CameraView& idr_view,
   if (shares) {
     const ViewShares s = MapShares(run->map, idr_view);
     rec->foveal_share = s.foveal;
-    rec->mapped_share = s.mapped;
     state->stalled = s.mapped - state->mapped_share < SelectionOptions::kStalledGrowth;
     state->mapped_share = s.mapped;
   }
