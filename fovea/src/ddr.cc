@@ -120,10 +120,10 @@ SelectionContext MakeContext(const FoveaRun& run, const LoopState& state,
 // reference view as it asks (with selection.first_fixation "idr", IDR's
 // point first; with selection.reference_fallback, a choice of mapped data in
 // the current view, of foveal data, or of mapped data after a stalled
-// fixation, gives way to a hole chosen in the reference view). With prescreen_holes, a hole whose
-// window has no unique match along its ray in the pair it was chosen in is passed over without a
-// move (and its neighbourhood with it, as a refused point's), up to
-// kMaxPrescreened times.
+// fixation, gives way to a hole chosen in the reference view). With
+// prescreen_holes, a hole whose window has no unique match along its ray in
+// the pair it was chosen in is passed over without a move (and its
+// neighbourhood with it, as a refused point's), up to kMaxPrescreened times.
 SelectionSummary ChooseTarget(const FoveaRun& run, LoopState& state, FixationStrategy& strategy,
                               const FoveaOptions& options, const DepthRange& hole_depths,
                               int attempt, std::mt19937_64* rng) {
