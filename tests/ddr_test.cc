@@ -204,7 +204,9 @@ TEST_CASE(
     RunFovea("--scene " + scene + " --seed " + seed + " --fixations " + fixations +
                  " --set selection.reference_fallback=" + fallback,
              with);
-    RunFovea("--scene " + scene + " --seed " + seed + " --fixations " + fixations, without);
+    RunFovea("--scene " + scene + " --seed " + seed + " --fixations " + fixations +
+                 " --set selection.reference_fallback=none",
+             without);
     const auto rw = Records(with), rn = Records(without);
     int fallbacks = 0;
     for (const auto& r : rw) {

@@ -71,7 +71,7 @@ TEST_CASE("map score: the pixels near edges are split by the source of the patch
   map.Add(quad(-0.5, w - 0.5, 1.2, fovea::PatchLevel::kIdr, 0));
   map.Add(quad(-0.5, w / 3, 0.9, fovea::PatchLevel::kPeripheral, 1));
   map.Add(quad(w / 3, 2 * w / 3, 0.55, fovea::PatchLevel::kFoveal, 0));
-  const experiments::MapScore score = experiments::ScoreMap(map, ref, sim->truth(), 0.06, false);
+  const experiments::MapScore score = experiments::ScoreMap(map, 0, ref, sim->truth(), 0.06, false);
   const nlohmann::json j = experiments::ScoreJson(score);
   const long edge_pixels = j["edge_pixels"];
   REQUIRE(edge_pixels > 0);
@@ -114,7 +114,7 @@ TEST_CASE("map score: the pixels near edges are split by the source of the patch
   CHECK(j["edge_good_coverage"].get<double>() < j["edge_coverage"].get<double>());
   // An empty map covers none of them; a view with no edge has no such share.
   const nlohmann::json empty = experiments::ScoreJson(
-      experiments::ScoreMap(fovea::PatchMap(), ref, sim->truth(), 0.06, false));
+      experiments::ScoreMap(fovea::PatchMap(), 0, ref, sim->truth(), 0.06, false));
   CHECK(empty["edge_visible_pixels"].get<long>() == edge_visible);
   CHECK(empty["edge_coverage"].get<double>() == 0);
   CHECK(empty["edge_good_coverage"].get<double>() == 0);
@@ -150,7 +150,7 @@ TEST_CASE("error picture: right pixels green, too near red, too far magenta, tru
   map.Add(quad(-0.5, 31.5, -0.5, 47.5, 1.003));  // the wall, 0.3% off: right
   map.Add(quad(31.5, 63.5, -0.5, 15.5, 0.45));   // the block's top, 10% too near
   map.Add(quad(31.5, 63.5, 15.5, 47.5, 0.53));   // the rest, 6% too far
-  const cv::Mat pic = experiments::ErrorPicture(map, ref);
+  const cv::Mat pic = experiments::ErrorPicture(map, 0, ref);
   REQUIRE(pic.size() == ref.depth_m.size());
   REQUIRE(pic.type() == CV_8UC3);
   auto at = [&](int x, int y) { return pic.at<cv::Vec3b>(y, x); };  // B, G, R

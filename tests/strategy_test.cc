@@ -233,20 +233,33 @@ TEST_CASE("selection.strategy names the strategy; deterministic keeps its meanin
     CHECK(fovea::MakeStrategy(o, fovea::CriteriaOptions{})->View() ==
           fovea::StrategyView::kReference);
   }
-  // The fallback replaces a choice in the current view: it names what it
-  // does not apply to instead of doing nothing.
+  // The fallback replaces a composite rule's choice in the current view;
+  // the strategies that choose in the reference view have none to replace
+  // (and the default, "stalled", must not refuse them).
+  CHECK(fovea::SelectionOptions{}.reference_fallback == "stalled");
   for (const char* fallback : {"mapped", "foveal", "stalled"}) {
+    INFO(fallback);
     fovea::SelectionOptions f;
     f.reference_fallback = fallback;
     CHECK_NOTHROW(f.Check());
+    CHECK(f.FallsBack());
     f.strategy = "deterministic";
-    CHECK_NOTHROW(f.Check());
+    CHECK(f.FallsBack());
     f.view = "reference";
-    CHECK_THROWS_WITH(f.Check(), Catch::Contains("selection.reference_fallback"));
+    CHECK_NOTHROW(f.Check());
+    CHECK_FALSE(f.FallsBack());
     f.view = "current";
-    f.strategy = "next_best_view";
-    CHECK_THROWS_WITH(f.Check(), Catch::Contains("selection.reference_fallback"));
+    for (const char* other : {"random", "raster", "next_best_view"}) {
+      f.strategy = other;
+      CHECK_NOTHROW(f.Check());
+      CHECK_FALSE(f.FallsBack());
+    }
   }
+  fovea::SelectionOptions none;
+  none.reference_fallback = "none";
+  CHECK_FALSE(none.FallsBack());
+  none.reference_fallback = "sometimes";
+  CHECK_THROWS_WITH(none.Check(), Catch::Contains("selection.reference_fallback"));
   fovea::SelectionOptions o;
   o.view = "home";
   CHECK_THROWS_WITH(o.Check(), Catch::Contains("selection.view"));

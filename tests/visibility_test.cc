@@ -269,3 +269,54 @@ TEST_CASE(
     CHECK(rest[1].corners_W == patches[2].corners_W);
   }
 }
+
+TEST_CASE("the reading rule leaves out a farther surface's pixels beside a nearer mapped one",
+          "[visibility]") {
+  // One row of 40 pixels: a near surface at 1 m over [0, 10), an unmapped
+  // strip [10, 12) (its edge left out), a far surface at 2 m over [12, 30)
+  // showing through it, unmapped [30, 40).
+  cv::Mat depth(3, 40, CV_32F, cv::Scalar(0));
+  depth.colRange(0, 10).setTo(1.0);
+  depth.colRange(12, 30).setTo(2.0);
+  cv::Mat ids(depth.size(), CV_32S, cv::Scalar(-1));
+  ids.colRange(0, 10).setTo(0);
+  ids.colRange(12, 30).setTo(1);
+  const cv::Mat given = depth.clone(), given_ids = ids.clone();
+
+  SECTION("pixels within flank_px of the nearer one are cleared, the rest kept") {
+    fovea::ClearFlankedFarther(4, &depth, &ids);
+    for (int y = 0; y < depth.rows; ++y)
+      for (int x = 0; x < depth.cols; ++x) {
+        CAPTURE(x, y);
+        // Column 9 is the last near one: 12 and 13 lie 3 and 4 px from it.
+        const bool cleared = x == 12 || x == 13;
+        CHECK(depth.at<float>(y, x) == (cleared ? 0.f : given.at<float>(y, x)));
+        CHECK(ids.at<int>(y, x) == (cleared ? -1 : given_ids.at<int>(y, x)));
+      }
+  }
+  SECTION("a wider flank reaches farther; the near surface is never cleared") {
+    fovea::ClearFlankedFarther(8, &depth);
+    CHECK(cv::countNonZero(depth.colRange(0, 10)) == 30);
+    CHECK(cv::countNonZero(depth.colRange(12, 18)) == 0);
+    CHECK(cv::countNonZero(depth.colRange(18, 30)) == 36);
+  }
+  SECTION("0 leaves the image as it is") {
+    fovea::ClearFlankedFarther(0, &depth, &ids);
+    CHECK(cv::countNonZero(depth != given) == 0);
+    CHECK(cv::countNonZero(ids != given_ids) == 0);
+  }
+  SECTION("a step of less than 2% of depth is a slope, not an edge") {
+    depth.colRange(12, 30).setTo(1.015);
+    const cv::Mat slope = depth.clone();
+    fovea::ClearFlankedFarther(4, &depth);
+    CHECK(cv::countNonZero(depth != slope) == 0);
+  }
+  SECTION("columns only: a nearer pixel above or below does not flank") {
+    cv::Mat column(40, 3, CV_32F, cv::Scalar(0));
+    column.rowRange(0, 10).setTo(1.0);
+    column.rowRange(12, 30).setTo(2.0);
+    const cv::Mat before = column.clone();
+    fovea::ClearFlankedFarther(4, &column);
+    CHECK(cv::countNonZero(column != before) == 0);
+  }
+}

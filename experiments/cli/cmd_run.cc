@@ -65,6 +65,11 @@ StaticSgbmOptions StaticOptionsOf(const RunConfig& config) {
   return options;
 }
 
+// The static pair's map is read as rendered: the reading rule
+// (integration.reference_flank_px) is FOVEA's, and the baseline stays one
+// plain StereoSGBM frame.
+constexpr int kStaticFlankPx = 0;
+
 int RunStatic(const RunConfig& config, OutputFolder& folder, Clock::time_point t_wall) {
   namespace rf = run_folder;
   auto sim = LoadSceneOf(config);
@@ -73,16 +78,18 @@ int RunStatic(const RunConfig& config, OutputFolder& folder, Clock::time_point t
   WriteTextAtomic(dir + "/" + rf::kConfig, DumpConfig(config));
   const ReferenceView ref = MakeReferenceView(rig, *sim);
   const StaticSgbmResult r = RunStaticSgbm(rig, StaticOptionsOf(config));
-  const MapScore score = ScoreMap(r.map, ref, sim->truth(), r.baseline_m, /*per_patch=*/true);
+  const MapScore score =
+      ScoreMap(r.map, kStaticFlankPx, ref, sim->truth(), r.baseline_m, /*per_patch=*/true);
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   for (const fovea::Patch& p : r.map.patches()) centre += p.Centre() / double(r.map.size());
   char caption[200];
   std::snprintf(caption, sizeof caption, "%s, static StereoSGBM at %.3f m: %s",
                 fs::path(sim->scene_path()).stem().c_str(), r.baseline_m,
                 ScoreLine(score, true).c_str());
-  WriteImageAtomic(dir + "/" + rf::kMapPicture, MapSnapshot(r.map, ref, centre, caption));
+  WriteImageAtomic(dir + "/" + rf::kMapPicture,
+                   MapSnapshot(r.map, kStaticFlankPx, ref, centre, caption));
   WriteImageAtomic(dir + "/" + rf::kReference, ref.view.gray);
-  WriteImageAtomic(dir + "/" + rf::kErrorPicture, ErrorPicture(r.map, ref));
+  WriteImageAtomic(dir + "/" + rf::kErrorPicture, ErrorPicture(r.map, kStaticFlankPx, ref));
   WriteTextAtomic(dir + "/" + rf::kMapPly, PatchMapPly(r.map));
   WriteTextAtomic(dir + "/" + rf::kRecords, "");
   nlohmann::json summary =
@@ -103,7 +110,8 @@ int RunStatic(const RunConfig& config, OutputFolder& folder, Clock::time_point t
 nlohmann::json VsStatic(rig::Rig& rig, const RunConfig& config, const fovea::PatchMap& map,
                         const ReferenceView& ref) {
   const StaticSgbmResult sgbm = RunStaticSgbm(rig, StaticOptionsOf(config));
-  const CommonPixels common = CompareOnCommonPixels(map, sgbm.map, ref);
+  const CommonPixels common =
+      CompareOnCommonPixels(map, config.fovea.integration.reference_flank_px, sgbm.map, ref);
   auto figure = [&](double v) { return common.pixels ? nlohmann::json(v) : nlohmann::json(); };
   return {{"pixels", common.pixels},
           {"fovea_median_abs_error_m", figure(common.median_abs_error_m)},
@@ -229,14 +237,15 @@ int Run(const RunArgs& args) {
   recorder.Finish();
   t = Clock::now();
   // What the map shows in the reference view: the patches the reference
-  // camera sees (the map keeps the others).
+  // camera sees (the map keeps the others), read by the reading rule.
   const fovea::PatchMap seen = fovea::ReferenceMap(run.map);
-  const MapScore score =
-      ScoreMap(seen, ref, sim->truth(), config.fovea.fixation.baseline_m, /*per_patch=*/true);
+  const int flank_px = config.fovea.integration.reference_flank_px;
+  const MapScore score = ScoreMap(seen, flank_px, ref, sim->truth(),
+                                  config.fovea.fixation.baseline_m, /*per_patch=*/true);
   // Where the fixations started from: the curves of coverage against
   // fixations and motion begin here.
   const MapScore idr_score =
-      ScoreMap(run.idr.map, ref, sim->truth(), config.fovea.fixation.baseline_m, false);
+      ScoreMap(run.idr.map, flank_px, ref, sim->truth(), config.fovea.fixation.baseline_m, false);
   const nlohmann::json vs_static =
       config.compare_static ? VsStatic(rig, config, seen, ref) : nlohmann::json();
   recorder.scoring_s += Since(t);
@@ -246,7 +255,7 @@ int Run(const RunArgs& args) {
   WriteImageAtomic(dir + "/" + rf::kFixationPath,
                    FixationPath(ref, recorder.path(), recorder.refused()));
   WriteImageAtomic(dir + "/" + rf::kReference, ref.view.gray);
-  WriteImageAtomic(dir + "/" + rf::kErrorPicture, ErrorPicture(seen, ref));
+  WriteImageAtomic(dir + "/" + rf::kErrorPicture, ErrorPicture(seen, flank_px, ref));
   recorder.output_s += Since(t);
   const double wall = Since(t_wall);
   nlohmann::json summary =

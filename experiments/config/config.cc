@@ -365,6 +365,7 @@ void AddDdrParams(RunConfig* c, std::vector<ConfigParam>* params) {
           {&fp::kIntegrationReferenceMinNcc, &f.integration.reference_min_ncc},
           {&fp::kIntegrationReferencePooledMinNcc, &f.integration.reference_pooled_min_ncc},
           {&fp::kIntegrationReferenceSidePx, &f.integration.reference_side_px},
+          {&fp::kIntegrationReferenceFlankPx, &f.integration.reference_flank_px},
       });
 }
 

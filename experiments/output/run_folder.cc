@@ -161,6 +161,7 @@ Recorder::Recorder(const std::string& dir, const std::string& scene_path, const 
       ref_(ref),
       truth_(truth),
       baseline_m_(config.fovea.fixation.baseline_m),
+      flank_px_(config.fovea.integration.reference_flank_px),
       fixations_(config.fovea.fixations),
       snapshots_(kSnapshotFixations.begin(), kSnapshotFixations.end()) {
   snapshots_.push_back(fixations_);
@@ -197,7 +198,7 @@ void Recorder::operator()(const fovea::FixationRecord& r, const fovea::PatchMap&
   if (r.ok) p.surface = SurfaceAt(r.fixation_W);
   p.map = std::make_shared<const fovea::PatchMap>(fovea::ReferenceMap(map));
   p.score = std::async(std::launch::async, [this, m = p.map] {
-    return ScoreMap(*m, ref_, truth_, baseline_m_, false);
+    return ScoreMap(*m, flank_px_, ref_, truth_, baseline_m_, false);
   });
   pending_ = std::move(p);
   scoring_s += fovea::Since(t);
@@ -237,7 +238,7 @@ void Recorder::Complete(Pending* pending) {
     std::snprintf(caption, sizeof caption, "%s after fixation %d: %s", scene_name_.c_str(),
                   r.fixation, ScoreLine(score, /*brief=*/true).c_str());
     WriteImageAtomic(dir_ + "/" + SnapshotName(r.fixation),
-                     MapSnapshot(*pending->map, ref_, view_target_, caption));
+                     MapSnapshot(*pending->map, flank_px_, ref_, view_target_, caption));
   }
   output_s += fovea::Since(t);
 }

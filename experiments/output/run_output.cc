@@ -123,11 +123,11 @@ cv::Mat ErrorPanel(const cv::Mat& map_depth, const cv::Mat& true_depth) {
   return img;
 }
 
-cv::Mat MapSnapshot(const fovea::PatchMap& map, const ReferenceView& ref,
+cv::Mat MapSnapshot(const fovea::PatchMap& map, int flank_px, const ReferenceView& ref,
                     const Eigen::Vector3d& target_W, const std::string& caption) {
   const int w = ref.view.intrinsics.width_px, h = ref.view.intrinsics.height_px;
   cv::Mat depth;
-  map.Render(ref.view.world_T_camera, ref.view.intrinsics, &depth, nullptr);
+  RenderInReference(map, flank_px, ref, &depth);
   double lo = 0, hi = 0;
   cv::minMaxLoc(ref.depth_m, &lo, &hi, nullptr, nullptr, ref.depth_m > 0);
   cv::Mat row;

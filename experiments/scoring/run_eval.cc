@@ -9,6 +9,7 @@
 #include "fovea/geometry.h"
 #include "fovea/integration.h"
 #include "fovea/stats.h"
+#include "fovea/visibility.h"
 #include "sim/sim_rig.h"
 
 namespace experiments {
@@ -317,11 +318,17 @@ void ScorePatches(const fovea::PatchMap& map, const rig::CameraView& view,
 
 }  // namespace
 
-MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref,
+void RenderInReference(const fovea::PatchMap& map, int flank_px, const ReferenceView& ref,
+                       cv::Mat* depth, cv::Mat* ids) {
+  map.Render(ref.view.world_T_camera, ref.view.intrinsics, depth, ids);
+  fovea::ClearFlankedFarther(flank_px, depth, ids);
+}
+
+MapScore ScoreMap(const fovea::PatchMap& map, int flank_px, const ReferenceView& ref,
                   const sim::GroundTruth& truth, double baseline_m, bool per_patch) {
   MapScore s;
   cv::Mat depth, ids;
-  map.Render(ref.view.world_T_camera, ref.view.intrinsics, &depth, &ids);
+  RenderInReference(map, flank_px, ref, &depth, &ids);
   const double f = ref.view.intrinsics.fx_px;
   Accumulator all, edges, edges_idr;
   std::array<Accumulator, 3> level;
@@ -410,9 +417,9 @@ MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref,
   return s;
 }
 
-cv::Mat ErrorPicture(const fovea::PatchMap& map, const ReferenceView& ref) {
+cv::Mat ErrorPicture(const fovea::PatchMap& map, int flank_px, const ReferenceView& ref) {
   cv::Mat depth;
-  map.Render(ref.view.world_T_camera, ref.view.intrinsics, &depth, nullptr);
+  RenderInReference(map, flank_px, ref, &depth);
   cv::Mat out(ref.view.gray.size(), CV_8UC3);
   constexpr double kFullRed = 0.05;  // relative error shown at full brightness
   for (int y = 0; y < out.rows; ++y)
@@ -526,10 +533,10 @@ nlohmann::json ScoreJson(const MapScore& s) {
   return j;
 }
 
-CommonPixels CompareOnCommonPixels(const fovea::PatchMap& map, const fovea::PatchMap& other,
-                                   const ReferenceView& ref) {
+CommonPixels CompareOnCommonPixels(const fovea::PatchMap& map, int flank_px,
+                                   const fovea::PatchMap& other, const ReferenceView& ref) {
   cv::Mat a, b;
-  map.Render(ref.view.world_T_camera, ref.view.intrinsics, &a, nullptr);
+  RenderInReference(map, flank_px, ref, &a);
   other.Render(ref.view.world_T_camera, ref.view.intrinsics, &b, nullptr);
   std::vector<double> ea, eb;
   for (int y = 0; y < a.rows; ++y)

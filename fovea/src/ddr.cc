@@ -161,7 +161,7 @@ SelectionSummary ChooseTarget(const FoveaRun& run, LoopState& state, FixationStr
                                                     static_cast<int>(chosen.pixel.x())) ==
            static_cast<signed char>(PatchLevel::kFoveal);
   };
-  if (fallback != "none" && !in_reference && state.has_fixation && chosen.ok && !chosen.in_hole &&
+  if (options.selection.FallsBack() && state.has_fixation && chosen.ok && !chosen.in_hole &&
       (fallback == "mapped" || (fallback == "stalled" ? state.stalled : chose_foveal()))) {
     const SelectionContext reference =
         MakeContext(run, state, run.idr.final_frame.left, false, options);
@@ -366,8 +366,9 @@ FoveaRun RunFovea(rig::Rig& rig, const StereoMatcher& matcher, const FoveaOption
     rec.fixation = ++run.fixations_done;
     RecordFixation(r, &rec);
     Absorb(r, idr_view, reference ? &*reference : nullptr, options.integration,
-           options.stall_fixations > 0 || options.selection.reference_fallback == "stalled", &run,
-           &state, &rec);
+           options.stall_fixations > 0 ||
+               (options.selection.FallsBack() && options.selection.reference_fallback == "stalled"),
+           &run, &state, &rec);
     record(rec);
     state.share_history.push_back(rec.foveal_share);
     if (Stalled(state.share_history, options)) {

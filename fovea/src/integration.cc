@@ -17,6 +17,7 @@ void IntegrationOptions::Check() const {
   rig::CheckParam(params::kIntegrationReferenceMinNcc, reference_min_ncc);
   rig::CheckParam(params::kIntegrationReferencePooledMinNcc, reference_pooled_min_ncc);
   rig::CheckParam(params::kIntegrationReferenceSidePx, reference_side_px);
+  rig::CheckParam(params::kIntegrationReferenceFlankPx, reference_flank_px);
 }
 
 namespace {

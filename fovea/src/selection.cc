@@ -248,6 +248,12 @@ cv::Mat Proximity3D::Evaluate(const SelectionContext& c) const {
   return w;
 }
 
+bool SelectionOptions::FallsBack() const {
+  const std::string rule = Strategy();
+  return reference_fallback != "none" && (rule == "fovea" || rule == "deterministic") &&
+         view == "current";
+}
+
 void SelectionOptions::Check() const {
   rig::CheckParam(params::kSelectionStrategy, strategy);
   rig::CheckParam(params::kSelectionFirstFixation, first_fixation);
@@ -256,13 +262,6 @@ void SelectionOptions::Check() const {
   if (deterministic && strategy != "fovea" && strategy != "deterministic")
     throw rig::InputError("key 'selection.deterministic': true applies to strategy fovea, not '" +
                           strategy + "'");
-  const std::string rule = Strategy();
-  if (reference_fallback != "none" &&
-      ((rule != "fovea" && rule != "deterministic") || view != "current"))
-    throw rig::InputError("key 'selection.reference_fallback': " + reference_fallback +
-                          " applies to strategy fovea or deterministic with selection.view "
-                          "current, not strategy '" +
-                          rule + "' with view '" + view + "'");
   rig::CheckParam(params::kSelectionFoveaSizePx, fovea_size_px);
   rig::CheckParam(params::kSelectionMotionWeight, motion_weight);
   rig::CheckParam(params::kSelectionHalfKnownRelSigma, half_known_rel_sigma);

@@ -223,4 +223,23 @@ PatchMap ReferenceMap(const PatchMap& map) {
   return seen;
 }
 
+void ClearFlankedFarther(int flank_px, cv::Mat* depth, cv::Mat* ids) {
+  if (flank_px <= 0) return;
+  const cv::Mat given = depth->clone();
+  const float nearer = static_cast<float>(1 - kFlankNearerShare);
+  for (int y = 0; y < given.rows; ++y) {
+    const float* row = given.ptr<float>(y);
+    for (int x = 0; x < given.cols; ++x) {
+      const float z = row[x];
+      if (!(z > 0)) continue;
+      const int u0 = std::max(0, x - flank_px), u1 = std::min(given.cols - 1, x + flank_px);
+      bool flanked = false;
+      for (int u = u0; u <= u1 && !flanked; ++u) flanked = row[u] > 0 && row[u] < nearer * z;
+      if (!flanked) continue;
+      depth->at<float>(y, x) = 0;
+      if (ids) ids->at<int>(y, x) = -1;
+    }
+  }
+}
+
 }  // namespace fovea

@@ -333,7 +333,8 @@ inline constexpr ParamSpec kSelectionReferenceFallback{
     "beyond the paper: when the composite rule's choice in the current view is mapped data "
     "(mapped), foveal data (foveal), or mapped data after a fixation that raised the map's share "
     "of the reference view by less than 0.002 (stalled), it chooses again in the reference view "
-    "and takes a hole chosen there instead (none: never)",
+    "and takes a hole chosen there instead (none: never); the other strategies, and view "
+    "reference, choose in the reference view already and have no fallback",
     0, 0, kSelectionReferenceFallbacks};
 inline constexpr ParamSpec kSelectionFoveaSizePx{
     "selection.fovea_size_px",
@@ -445,6 +446,12 @@ inline constexpr ParamSpec kIntegrationReferenceSidePx{
     "and those the reference camera does not see are cut from its depth in the reference view (a "
     "farther surface's few pixels past a nearer one's edge; 0 = no strips)",
     0, 16};
+inline constexpr ParamSpec kIntegrationReferenceFlankPx{
+    "integration.reference_flank_px",
+    "beyond the paper: in the map's depth in the reference view, as the run reports and scores "
+    "it, a pixel with a mapped pixel more than 2% nearer within this many pixels along its row is "
+    "left out (a farther surface showing through a nearer one's unmapped edge; 0 = none)",
+    0, 64};
 inline constexpr ParamSpec kLoopFixations{"loop.fixations", "successful fixations to make", 1,
                                           10000};
 inline constexpr ParamSpec kLoopStayInIdrView{

@@ -103,4 +103,23 @@ int MarkHiddenFromReference(PatchMap* patches, const rig::CameraView& measured,
 /// its Patch::reference_part.
 PatchMap ReferenceMap(const PatchMap& map);
 
+/// Leaves out of a depth image of a map (0: unmapped) each pixel with a
+/// mapped pixel more than 2% nearer (kFlankNearerShare) within `flank_px`
+/// along its row, either side; `ids`, if given (the patch ids of the same
+/// render), gets -1 there. The reading rule of the map's depth in the
+/// reference view (IntegrationOptions::reference_flank_px): where a nearer
+/// surface's edge is left unmapped (the strips ReferenceSides cuts, the
+/// blocks whose fit fails across the step), a farther surface's patch
+/// measured from another viewpoint shows through it, far off the true depth;
+/// its pixels beside the nearer mapped one are the ones left out. The rig
+/// moves along its rail, so those strips run up and down the image: the
+/// rule reads along rows. Every pixel is judged against the image as given.
+/// flank_px <= 0 leaves the image as it is. Cost: O(pixels x flank_px).
+void ClearFlankedFarther(int flank_px, cv::Mat* depth, cv::Mat* ids = nullptr);
+
+/// How much nearer a flanking pixel must be, a share of the pixel's depth:
+/// a step between surfaces, not a slanted surface's own slope over a few
+/// pixels.
+constexpr double kFlankNearerShare = 0.02;
+
 }  // namespace fovea

@@ -109,6 +109,7 @@ class Recorder {
   const ReferenceView& ref_;
   const sim::GroundTruth& truth_;
   double baseline_m_;
+  int flank_px_;  ///< IntegrationOptions::reference_flank_px
   int fixations_;
   std::vector<int> snapshots_;
   Eigen::Vector3d view_target_ = Eigen::Vector3d::Zero();

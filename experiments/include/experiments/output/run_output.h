@@ -30,9 +30,9 @@ cv::Mat PatchDepthBesideTruth(const fovea::PatchMap& map, const rig::CameraView&
                               const sim::GroundTruth& truth);
 
 /// The map after a fixation as the paper shows it: the oblique view, the
-/// map's depth in the reference view and the true depth (same colours), with
-/// a caption.
-cv::Mat MapSnapshot(const fovea::PatchMap& map, const ReferenceView& ref,
+/// map's depth in the reference view (read with `flank_px`,
+/// RenderInReference) and the true depth (same colours), with a caption.
+cv::Mat MapSnapshot(const fovea::PatchMap& map, int flank_px, const ReferenceView& ref,
                     const Eigen::Vector3d& target_W, const std::string& caption);
 
 /// The reference image with the fixation points, numbered and joined in

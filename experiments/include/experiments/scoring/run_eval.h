@@ -140,26 +140,35 @@ inline constexpr double kStaleCoveredShare = 0.9;
 int StaleIdrPatches(const fovea::PatchMap& map, const rig::CameraView& view,
                     const std::vector<char>& off_surface);
 
-/// Where `map` is right and wrong in the reference view (BGR, the view's
-/// size): the reference image dimmed; the mapped textured pixels (those the
-/// score counts) green within kBadShare of the true depth; beyond it, red
-/// where the map is nearer than the truth and magenta where it is farther
-/// (brighter the larger the error, full at 5%); the true depth
-/// discontinuities (ref.depth_edges, if set) blue.
-cv::Mat ErrorPicture(const fovea::PatchMap& map, const ReferenceView& ref);
+/// `map`'s depth in the reference view (0: unmapped) and, if `ids` is
+/// given, its patch ids (-1: none), read by the reading rule with `flank_px`
+/// (fovea::ClearFlankedFarther; 0: as rendered). FOVEA's map is read with
+/// IntegrationOptions::reference_flank_px; the static pair's, which is no
+/// part of FOVEA, with 0.
+void RenderInReference(const fovea::PatchMap& map, int flank_px, const ReferenceView& ref,
+                       cv::Mat* depth, cv::Mat* ids = nullptr);
 
-/// Scores `map` in the reference view; `baseline_m` sets the disparity step.
-MapScore ScoreMap(const fovea::PatchMap& map, const ReferenceView& ref,
+/// Where `map` (read with `flank_px`, RenderInReference) is right and wrong
+/// in the reference view (BGR, the view's size): the reference image dimmed; the mapped textured
+/// pixels (those the score counts) green within kBadShare of the true depth; beyond it, red where
+/// the map is nearer than the truth and magenta where it is farther (brighter the larger the error,
+/// full at 5%); the true depth discontinuities (ref.depth_edges, if set) blue.
+cv::Mat ErrorPicture(const fovea::PatchMap& map, int flank_px, const ReferenceView& ref);
+
+/// Scores `map`, read with `flank_px` (RenderInReference), in the reference
+/// view; `baseline_m` sets the disparity step.
+MapScore ScoreMap(const fovea::PatchMap& map, int flank_px, const ReferenceView& ref,
                   const sim::GroundTruth& truth, double baseline_m, bool per_patch);
 
 /// Two maps on the pixels both map in the reference view (visible,
 /// textured): how many, and each one's median absolute depth error there.
+/// `map` is read with `flank_px` (RenderInReference), `other` as rendered.
 struct CommonPixels {
   long pixels = 0;
   double median_abs_error_m = 0, other_median_abs_error_m = 0;
 };
-CommonPixels CompareOnCommonPixels(const fovea::PatchMap& map, const fovea::PatchMap& other,
-                                   const ReferenceView& ref);
+CommonPixels CompareOnCommonPixels(const fovea::PatchMap& map, int flank_px,
+                                   const fovea::PatchMap& other, const ReferenceView& ref);
 
 /// The figures as summary.json holds them. Error figures over no pixel (an
 /// empty map, an unmapped level or surface) are null, not zero.
