@@ -291,6 +291,7 @@ TEST_CASE("the cost-volume matcher gives what its rules give, pixel by pixel", "
       hi.at<float>(y, x) = static_cast<float>(u);
     }
   fovea::Nl1Options options;
+  options.weak_window_half_px = 0;  // the plain matcher's one window
   options.cost = GENERATE(as<std::string>(), "window_mean", "prenormalized", "zero_mean_ssd");
   INFO("cost " << options.cost);
   const Reference ref = MatchPlainly(left, right, lo, hi, options);
@@ -354,6 +355,7 @@ TEST_CASE("NL1 takes a wider window on a faint texture, and the narrow one elsew
   }
   const cv::Mat lo(left.size(), CV_32F, cv::Scalar(-4)), hi(left.size(), CV_32F, cv::Scalar(12));
   fovea::Nl1Options narrow_only;
+  narrow_only.weak_window_half_px = 0;
   fovea::Nl1Options split = narrow_only;
   split.weak_window_half_px = 5;
   split.weak_texture_dn = 8;
