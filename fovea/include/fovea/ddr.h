@@ -104,8 +104,8 @@ struct FixationRecord {
   IntegrationStats integration;
   std::array<int, 3> map_by_level{0, 0, 0};
   /// The map's foveal share of the IDR view, as the loop sees it (computed
-  /// only for the stall rule, loop.stall_fixations > 0, and with
-  /// selection.reference_fallback "stalled"; else 0).
+  /// only for the stall rule, loop.stall_fixations > 0, and when the
+  /// "stalled" fallback is in force, SelectionOptions::FallsBack; else 0).
   double foveal_share = 0;
   double motion_time_s = 0;
   /// The attempt's stage travel, from the state before it to the state after

@@ -149,10 +149,12 @@ void RenderInReference(const fovea::PatchMap& map, int flank_px, const Reference
                        cv::Mat* depth, cv::Mat* ids = nullptr);
 
 /// Where `map` (read with `flank_px`, RenderInReference) is right and wrong
-/// in the reference view (BGR, the view's size): the reference image dimmed; the mapped textured
-/// pixels (those the score counts) green within kBadShare of the true depth; beyond it, red where
-/// the map is nearer than the truth and magenta where it is farther (brighter the larger the error,
-/// full at 5%); the true depth discontinuities (ref.depth_edges, if set) blue.
+/// in the reference view (BGR, the view's size): the reference image
+/// dimmed; the mapped textured pixels (those the score counts) green within
+/// kBadShare of the true depth; beyond it, red where the map is nearer than
+/// the truth and magenta where it is farther (brighter the larger the
+/// error, full at 5%); the true depth discontinuities (ref.depth_edges, if
+/// set) blue.
 cv::Mat ErrorPicture(const fovea::PatchMap& map, int flank_px, const ReferenceView& ref);
 
 /// Scores `map`, read with `flank_px` (RenderInReference), in the reference
