@@ -36,6 +36,9 @@ TEST_CASE("foveal and peripheral depth accuracy at three fixations per scene",
     // foveal.mapped_baseline_m (0.09 m); a hole's point at foveal.baseline_m
     // (0.06 m).
     fovea::FixationOptions o = fovea::ResolvedFixationOptions({});
+    // The two cameras, as measured (the left camera paired with itself,
+    // tried first by default, refuses the block's point: no mutual match).
+    o.left_pair_first = false;
     for (const double mapped_baseline_m : {o.mapped_baseline_m, 0.0}) {
       o.mapped_baseline_m = mapped_baseline_m;
       const fovea::FixationResult r = fovea::Fixate(sim->rig(), idr.map, pt.p_W, matcher, o);
@@ -180,6 +183,9 @@ TEST_CASE("peripheral blocks are not split below the matching window beside dept
     const fovea::IdrResult idr = fovea::RunIdr(sim->rig(), {});
     fovea::FixationOptions o = fovea::ResolvedFixationOptions({});  // the run's
     o.foveal.periphery_min_block_px = periphery_min_block_px;
+    // The two cameras, as measured (the left camera paired with itself
+    // finds no mutual match at this point and refuses it).
+    o.left_pair_first = false;
     // In the verged pair's rows, as measured: in the rectified pair the
     // quarters are mostly right too (measured 7 of 231 off by over 5%).
     o.foveal.rectified_periphery = false;
@@ -315,6 +321,7 @@ TEST_CASE("at a near fixation the rectified periphery maps what the verged pair'
   const fovea::IdrResult idr = fovea::RunIdr(sim->rig(), {});
   const fovea::Nl1Matcher matcher;
   fovea::FixationOptions o = fovea::ResolvedFixationOptions({});
+  o.left_pair_first = false;  // the verged pair of the two cameras, as measured
   const Eigen::Vector3d p_W(0.0331, 0.6222, -0.0089);
   struct Level1 {
     int patches = 0;

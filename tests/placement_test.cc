@@ -11,13 +11,14 @@ const rig::CameraIntrinsics kCamera =
 constexpr double kBaseline = 0.06;
 
 // The simulator's default rig, home pose 0.10 m wide.
-fovea::PlacementRig TestRig(bool left_pair = true) {
+fovea::PlacementRig TestRig(bool left_pair = true, bool left_pair_first = false) {
   fovea::PlacementRig r;
   r.geometry = TestGeometry();
   r.limits = TestLimits();
   r.left = r.right = kCamera;
   r.home_left_m = -0.05;
   r.left_pair = left_pair;
+  r.left_pair_first = left_pair_first;
   return r;
 }
 
@@ -153,4 +154,34 @@ TEST_CASE(
                         b = OpticalCentre(with, rig::Side::kRight);
   CHECK(a.x() < b.x());
   CHECK(b.x() < -0.04);
+}
+
+TEST_CASE(
+    "placement: with left_pair_first the left camera pairs with itself unless the map hides "
+    "the point from it",
+    "[fovea][placement]") {
+  const Eigen::Vector3d p(0.0, 1.2, 0.0);
+  fovea::PatchMap map;
+  map.Add(Square(p, 0.2));
+  auto choose = [&](bool left_pair) {
+    return fovea::ChoosePlacement(TestRig(left_pair, true), map, p, kBaseline, {}, std::nullopt);
+  };
+  const fovea::PlacementChoice first = choose(true);
+  REQUIRE(first.vergence.ok);
+  CHECK(first.placement == fovea::Placement::kLeftPair);
+  CHECK(first.occluded == 0);
+  CHECK(first.vergence.state.right.carriage_m == Approx(-0.05).margin(1e-5));
+  // Without the left camera pair the setting changes nothing.
+  CHECK(choose(false).placement == fovea::Placement::kRightInner);
+
+  // A 4 mm square halfway along the line of sight of the pair's "right"
+  // stage (the home pose's left camera, x = -0.05): the right carriage
+  // innermost is next, and its cameras (x = -0.0595 and 0.0005) look past
+  // it, 4.75 mm and 25 mm from its centre there.
+  const Eigen::Vector3d home_left = OpticalCentre(first, rig::Side::kRight);
+  map.Add(Square(0.5 * (home_left + p), 0.002));
+  const fovea::PlacementChoice moved = choose(true);
+  REQUIRE(moved.vergence.ok);
+  CHECK(moved.placement == fovea::Placement::kRightInner);
+  CHECK(moved.occluded == 0);
 }

@@ -267,6 +267,7 @@ void AddFovealParams(RunConfig* c, std::vector<ConfigParam>* params) {
                      {&fp::kFovealMappedBaselineM, &x.mapped_baseline_m},
                      {&fp::kFovealChoosePlacement, &x.choose_placement},
                      {&fp::kFovealLeftPair, &x.left_pair},
+                     {&fp::kFovealLeftPairFirst, &x.left_pair_first},
                      {&fp::kFovealMapCheck, &x.map_check},
                      {&fp::kFovealVergenceMaxIterations, &x.vergence.max_iterations},
                      {&fp::kFovealVergenceTolerancePx, &x.vergence.tolerance_px},

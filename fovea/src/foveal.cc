@@ -760,8 +760,8 @@ FixationResult Fixate(rig::Rig& rig, const PatchMap& map, const Eigen::Vector3d&
                                                                   : options.baseline_m;
   if (options.choose_placement) {
     const PlacementChoice choice =
-        ChoosePlacement(PlacementRig::Of(rig, options.left_pair), map, p_W, r.baseline_m,
-                        options.vergence, guessed_depths);
+        ChoosePlacement(PlacementRig::Of(rig, options.left_pair, options.left_pair_first), map, p_W,
+                        r.baseline_m, options.vergence, guessed_depths);
     r.placement = choice.placement;
     r.vergence = choice.vergence;
   } else {

@@ -20,7 +20,7 @@ const char* PlacementName(Placement placement) {
   return "?";
 }
 
-PlacementRig PlacementRig::Of(const rig::Rig& rig, bool left_pair) {
+PlacementRig PlacementRig::Of(const rig::Rig& rig, bool left_pair, bool left_pair_first) {
   PlacementRig r;
   r.geometry = rig.Geometry();
   r.limits = rig.Limits();
@@ -28,6 +28,7 @@ PlacementRig PlacementRig::Of(const rig::Rig& rig, bool left_pair) {
   r.right = rig.Intrinsics(rig::Side::kRight);
   r.home_left_m = rig.Home().left.carriage_m;
   r.left_pair = left_pair;
+  r.left_pair_first = left_pair_first;
   return r;
 }
 
@@ -71,8 +72,11 @@ PlacementChoice ChoosePlacement(const PlacementRig& rig, const PatchMap& map,
     return hit && hit->distance_m < (1 - kNearerShare) * distance;
   };
   std::optional<PlacementChoice> best, failed;
-  for (Placement placement : {Placement::kRightInner, Placement::kSymmetric, Placement::kLeftInner,
-                              Placement::kLeftPair}) {
+  constexpr Placement kPairsFirst[] = {Placement::kRightInner, Placement::kSymmetric,
+                                       Placement::kLeftInner, Placement::kLeftPair};
+  constexpr Placement kLeftPairFirst[] = {Placement::kLeftPair, Placement::kRightInner,
+                                          Placement::kSymmetric, Placement::kLeftInner};
+  for (Placement placement : rig.left_pair_first ? kLeftPairFirst : kPairsFirst) {
     if (placement == Placement::kLeftPair && !rig.left_pair) continue;
     const PlacementRig pair = rig.For(placement);
     const rig::RigGeometry& geometry = pair.geometry;

@@ -98,6 +98,12 @@ inline constexpr ParamSpec kFovealLeftPair{"foveal.left_pair",
                                            "the left camera with itself at two carriage positions "
                                            "(the home pose's and foveal.baseline_m to its left; "
                                            "motion stereo, the scene must hold still)"};
+inline constexpr ParamSpec kFovealLeftPairFirst{
+    "foveal.left_pair_first",
+    "beyond the paper, with foveal.left_pair: try the left camera paired with itself first, "
+    "before the two-camera placements (its right stage is the home pose's left camera, so it sees "
+    "what the reference views see; about 2.4 times the motion); false: only where the map hides "
+    "the point from every right camera"};
 inline constexpr ParamSpec kFovealMapCheck{
     "foveal.map_check",
     "beyond the paper: refuse a fixation whose servoed point lies in front of a surface the map "

@@ -36,7 +36,9 @@ struct PlacementRig {
   rig::CameraIntrinsics left, right;
   double home_left_m = 0;  ///< the left carriage at the home pose
   bool left_pair = true;   ///< also consider Placement::kLeftPair
-  static PlacementRig Of(const rig::Rig& rig, bool left_pair);
+  /// With left_pair: try Placement::kLeftPair first rather than last.
+  bool left_pair_first = false;
+  static PlacementRig Of(const rig::Rig& rig, bool left_pair, bool left_pair_first);
   /// Geometry, limits and right intrinsics of the pair `placement` uses
   /// (the virtual pair's for kLeftPair).
   PlacementRig For(Placement placement) const;
@@ -69,7 +71,10 @@ struct PlacementChoice {
 /// Returns the first placement with the fewest hidden samples (at once when
 /// one hides none), or the first whose vergence failed if none can fixate
 /// p_W. Last, if `rig.left_pair`, the left camera pair (kLeftPair), which
-/// costs twice the moves. Cost: 4 vergences and up to 56 ray casts, each
+/// costs twice the moves; with `rig.left_pair_first` it is tried first
+/// instead: its "right" stage sits where the home pose's left camera does,
+/// so it sees what the reference views see (fewer strips past nearer
+/// surfaces' edges missed). Cost: 4 vergences and up to 56 ray casts, each
 /// O(log patches).
 PlacementChoice ChoosePlacement(const PlacementRig& rig, const PatchMap& map,
                                 const Eigen::Vector3d& p_W, double baseline_m,
