@@ -33,8 +33,9 @@ fovea::Patch Square(const Eigen::Vector3d& centre_W, double half) {
 
 fovea::PlacementChoice Choose(const fovea::PatchMap& map, const Eigen::Vector3d& p_W,
                               const std::optional<fovea::DepthRange>& guessed = std::nullopt,
-                              bool left_pair = true) {
-  return fovea::ChoosePlacement(TestRig(left_pair), map, p_W, kBaseline, {}, guessed);
+                              bool left_pair = true, bool left_pair_first = false) {
+  return fovea::ChoosePlacement(TestRig(left_pair, left_pair_first), map, p_W, kBaseline, {},
+                                guessed);
 }
 
 // The optical centre of one camera of the pair the choice uses.
@@ -163,9 +164,7 @@ TEST_CASE(
   const Eigen::Vector3d p(0.0, 1.2, 0.0);
   fovea::PatchMap map;
   map.Add(Square(p, 0.2));
-  auto choose = [&](bool left_pair) {
-    return fovea::ChoosePlacement(TestRig(left_pair, true), map, p, kBaseline, {}, std::nullopt);
-  };
+  auto choose = [&](bool left_pair) { return Choose(map, p, std::nullopt, left_pair, true); };
   const fovea::PlacementChoice first = choose(true);
   REQUIRE(first.vergence.ok);
   CHECK(first.placement == fovea::Placement::kLeftPair);

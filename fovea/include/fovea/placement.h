@@ -59,23 +59,24 @@ struct PlacementChoice {
 /// edge: past a near surface's left edge lies a strip the left camera sees
 /// and the right one does not (and the reverse past a right edge), as wide as
 /// the carriages are apart. The views the map is built for (IDR's, the home
-/// pose's) have their left camera left of the rail centre, so the right
-/// carriage innermost is tried first: it puts the right camera as near them
-/// as the rail allows and leaves the thinnest strips past left edges (which
-/// IDR's pair, its right camera moving right, cannot see either). Then
-/// symmetric, then left innermost, then the left camera pair. For each, this verges on p_W and
-/// raytraces the map from both optical centres to sample points: p_W, and
-/// when its depth is a guess (`guessed_depths`, a hole), the points behind it
-/// on the left optical axis up to 4 times its depth. A sample is hidden from
+/// pose's) have their left camera left of the rail centre, so of the
+/// two-camera placements the right carriage innermost is tried first: it
+/// puts the right camera as near them as the rail allows and leaves the
+/// thinnest strips past left edges (which IDR's pair, its right camera
+/// moving right, cannot see either). Then symmetric, then left innermost.
+/// For each, this verges on p_W and raytraces the map from both optical
+/// centres to sample points: p_W, and when its depth is a guess
+/// (`guessed_depths`, a hole), the points behind it on the left optical
+/// axis up to 4 times its depth. A sample is hidden from
 /// a camera when the map has a patch more than 3% nearer along the ray.
 /// Returns the first placement with the fewest hidden samples (at once when
 /// one hides none), or the first whose vergence failed if none can fixate
-/// p_W. Last, if `rig.left_pair`, the left camera pair (kLeftPair), which
-/// costs twice the moves; with `rig.left_pair_first` it is tried first
-/// instead: its "right" stage sits where the home pose's left camera does,
-/// so it sees what the reference views see (fewer strips past nearer
-/// surfaces' edges missed). Cost: 4 vergences and up to 56 ray casts, each
-/// O(log patches).
+/// p_W. If `rig.left_pair`, the left camera pair (kLeftPair), which costs
+/// twice the moves, is tried too: last, or with `rig.left_pair_first`
+/// before the others (its "right" stage sits where the home pose's left
+/// camera does, so it sees what the reference views see, strips past
+/// nearer surfaces' edges included). Cost: 4 vergences and up to 56 ray
+/// casts, each O(log patches).
 PlacementChoice ChoosePlacement(const PlacementRig& rig, const PatchMap& map,
                                 const Eigen::Vector3d& p_W, double baseline_m,
                                 const VergenceOptions& vergence,
