@@ -342,6 +342,65 @@ TEST_CASE("blocks across a depth step split instead of bridging it", "[fovea][pa
   CHECK(whole_blocks == 12);  // 4 rows x (2 left + 1 right) blocks clear of x = 32..47
 }
 
+TEST_CASE("with half_agreement a half-block extends a whole neighbour's surface up to a step",
+          "[fovea][patch]") {
+  // Two 16-pixel blocks that cannot be split (min_block_px 16, the
+  // periphery's), side by side or one above the other. A nearer slanted
+  // surface (disparity 20 + 0.05 x) fills the first block and the first
+  // half of the second; a farther one (10) the second half; noise 0.1 px.
+  std::mt19937_64 rng(9);
+  std::normal_distribution<float> noise(0, 0.1f);
+  auto near = [](int x) { return 20.0 + 0.05 * x; };
+  fovea::PlaneFitOptions options;
+  options.min_support = 12;
+  options.fit_tolerance_px = 0.7;
+  options.min_inlier_share = 0.8;
+  fovea::BlockOptions blocks;
+  blocks.min_block_px = 16;
+  for (const bool rows : {false, true}) {
+    INFO((rows ? "blocks one above the other" : "blocks side by side"));
+    const cv::Size size = rows ? cv::Size(16, 32) : cv::Size(32, 16);
+    cv::Mat d(size, CV_32F);
+    for (int y = 0; y < d.rows; ++y)
+      for (int x = 0; x < d.cols; ++x)
+        d.at<float>(y, x) = static_cast<float>(((rows ? y : x) < 24 ? near(x) : 10.0) + noise(rng));
+    blocks.half_agreement = 0;
+    const auto without = fovea::FitBlocks(d, 16, options, blocks, nullptr);
+    REQUIRE(without.size() == 1);  // the first block; the second is not whole
+    blocks.half_agreement = 2;
+    const auto with = fovea::FitBlocks(d, 16, options, blocks, nullptr);
+    // The first block, then its surface's half of the second. The farther
+    // half is whole too, but no whole block beside it holds its surface.
+    REQUIRE(with.size() == 2);
+    CHECK(with[0].footprint.isApprox(without[0].footprint));
+    const Eigen::Vector4d half =
+        rows ? Eigen::Vector4d(-0.5, 15.5, 15.5, 23.5) : Eigen::Vector4d(15.5, -0.5, 23.5, 15.5);
+    CHECK(with[1].footprint.isApprox(half));
+    // No footprint reaches over the step: its plane is within the fit
+    // tolerance of the truth at every pixel it covers.
+    double worst = 0;
+    for (const fovea::BlockFit& b : with)
+      for (int y = 0; y < d.rows; ++y)
+        for (int x = 0; x < d.cols; ++x)
+          if (x >= b.footprint(0) && x <= b.footprint(2) && y >= b.footprint(1) &&
+              y <= b.footprint(3))
+            worst = std::max(worst, std::abs(((rows ? y : x) < 24 ? near(x) : 10.0) - b.fit(x, y)));
+    CHECK(worst <= options.fit_tolerance_px);
+  }
+  // A half of another depth (a false match, 30 px) beside scattered
+  // matches, next to a whole block of the nearer surface: it extends
+  // nothing, so it stays out.
+  cv::Mat d(16, 32, CV_32F);
+  std::uniform_real_distribution<float> anywhere(0, 40);
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 32; ++x)
+      d.at<float>(y, x) = x < 16   ? static_cast<float>(near(x)) + noise(rng)
+                          : x < 24 ? 30.f + noise(rng)
+                                   : anywhere(rng);
+  blocks.half_agreement = 2;
+  CHECK(fovea::FitBlocks(d, 16, options, blocks, nullptr).size() == 1);
+}
+
 TEST_CASE("a block's patch covers its inliers, not the far side of an edge without data",
           "[fovea][patch]") {
   // One 16-pixel block: a plane on its left 11 columns; the rest has no

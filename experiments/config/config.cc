@@ -286,6 +286,7 @@ void AddFovealParams(RunConfig* c, std::vector<ConfigParam>* params) {
                      {&fp::kFovealMinFillShare, &x.foveal.blocks.min_fill_share},
                      {&fp::kFovealMinBlockPx, &x.foveal.blocks.min_block_px},
                      {&fp::kFovealPeripheryMinBlockPx, &x.foveal.periphery_min_block_px},
+                     {&fp::kFovealPeripheryHalfAgreement, &x.foveal.periphery_half_agreement},
                      {&fp::kFovealClipToInliers, &x.foveal.blocks.clip_to_inliers},
                      {&fp::kFovealClipDiagonals, &x.foveal.blocks.clip_diagonals},
                      {&fp::kFovealRectify, &x.foveal.rectify},

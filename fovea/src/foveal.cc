@@ -28,6 +28,7 @@ void FovealOptions::Check() const {
   rig::CheckParam(params::kFovealMinFillShare, blocks.min_fill_share);
   rig::CheckParam(params::kFovealMinBlockPx, blocks.min_block_px);
   rig::CheckParam(params::kFovealPeripheryMinBlockPx, periphery_min_block_px);
+  rig::CheckParam(params::kFovealPeripheryHalfAgreement, periphery_half_agreement);
   plane_fit.Check(params::kFovealFitMinSupport, params::kFovealFitTolerancePx,
                   params::kFovealFitMinInlierShare);
   // Set from idr.z_min_m (ResolvedFixationOptions), not a parameter of its own.
@@ -542,6 +543,7 @@ int LevelPatches(const rig::StereoFrame& frame, const Level& level, const Inner&
   BlockOptions blocks = options.blocks;
   if (level.index > 0) {
     blocks.min_block_px = std::max(blocks.min_block_px, options.periphery_min_block_px);
+    blocks.half_agreement = options.periphery_half_agreement;
     // A peripheral block's hull, cut at a corner its sparser matches miss,
     // gave up more right pixels than wrong ones (README, issue 19).
     blocks.clip_diagonals = false;

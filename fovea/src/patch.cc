@@ -4,6 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <optional>
+#include <utility>
 
 #include "fovea/parallel.h"
 
@@ -159,9 +162,68 @@ Quad2d BoxQuad(const Eigen::Vector4d& box) {
 
 namespace {
 
+// The plane of `samples` in the rectangle [x0, x0 + w) x [y0, y0 + h) of
+// block (bx, by, size), if the rectangle is whole by BlockOptions' rule (its
+// inliers fill `fill` of it, at most 5% of its measurements are outliers,
+// inliers in all four of its quadrants); its footprint is its inliers' box.
+std::optional<BlockFit> WholeHalf(const std::vector<DisparitySample>& samples, int bx, int by,
+                                  int size, int x0, int y0, int w, int h,
+                                  const PlaneFitOptions& options, double fill) {
+  std::vector<DisparitySample> in;
+  for (const DisparitySample& s : samples)
+    if (s.x_px >= x0 && s.x_px < x0 + w && s.y_px >= y0 && s.y_px < y0 + h) in.push_back(s);
+  // The fit's own quadrants are the block's; the half's are checked below.
+  PlaneFitOptions o = options;
+  o.require_quadrants = false;
+  Eigen::Vector4d box;
+  const auto fit = FitDisparityPlane(in, bx, by, size, o, &box, nullptr);
+  if (!fit || fit->support < fill * w * h ||
+      static_cast<int>(in.size()) - fit->support > std::max(1.0, 0.05 * double(in.size())))
+    return std::nullopt;
+  bool quadrant[4] = {false, false, false, false};
+  const double cx = x0 + 0.5 * w - 0.5, cy = y0 + 0.5 * h - 0.5;
+  for (const DisparitySample& s : in)
+    if (std::abs(s.disparity_px - (*fit)(s.x_px, s.y_px)) <= options.fit_tolerance_px)
+      quadrant[(s.x_px >= cx ? 1 : 0) + (s.y_px >= cy ? 2 : 0)] = true;
+  if (!(quadrant[0] && quadrant[1] && quadrant[2] && quadrant[3])) return std::nullopt;
+  BlockFit half{bx, by, size, *fit};
+  half.footprint = Eigen::Vector4d(box(0) - 0.5, box(1) - 0.5, box(2) + 0.5, box(3) + 0.5);
+  half.corners = BoxQuad(half.footprint);
+  return half;
+}
+
+// The whole halves of a block that is not whole: side by side, or one above
+// the other, whichever cut's whole halves hold more inliers (BlockOptions::
+// half_agreement).
+std::vector<BlockFit> WholeHalves(const std::vector<DisparitySample>& samples, int bx, int by,
+                                  int size, const PlaneFitOptions& options, double fill) {
+  const int half = size / 2;
+  std::vector<BlockFit> best;
+  int best_support = 0;
+  for (const bool above : {false, true}) {
+    std::vector<BlockFit> halves;
+    int support = 0;
+    for (int h = 0; h < 2; ++h)
+      if (const auto f = WholeHalf(samples, bx, by, size, above ? bx : bx + h * half,
+                                   above ? by + h * half : by, above ? size : half,
+                                   above ? half : size, options, fill)) {
+        halves.push_back(*f);
+        support += f->fit.support;
+      }
+    if (support > best_support) {
+      best = std::move(halves);
+      best_support = support;
+    }
+  }
+  return best;
+}
+
+// A block's planes into `out` by BlockOptions' rule; with
+// BlockOptions::half_agreement, the whole halves of a smallest block that is
+// not whole into `halves`, for FitBlocks to check against their neighbours.
 void FitBlock(const cv::Mat& disparity, const cv::Mat& unbounded, int bx, int by, int size,
               const PlaneFitOptions& options, const BlockOptions& blocks,
-              std::vector<BlockFit>* out) {
+              std::vector<BlockFit>* out, std::vector<BlockFit>* halves) {
   PlaneFitOptions o = options;
   o.min_support = std::min(options.min_support, (3 * size * size) / 4);
   std::vector<DisparitySample> samples;
@@ -199,10 +261,17 @@ void FitBlock(const cv::Mat& disparity, const cv::Mat& unbounded, int bx, int by
     return;
   }
   const int half = size / 2;
-  if (fill <= 0 || half < blocks.min_block_px) return;
+  if (fill <= 0) return;
+  if (half < blocks.min_block_px) {
+    if (blocks.half_agreement > 0 && half >= 1) {
+      const std::vector<BlockFit> whole = WholeHalves(samples, bx, by, size, o, fill);
+      halves->insert(halves->end(), whole.begin(), whole.end());
+    }
+    return;
+  }
   for (int q = 0; q < 4; ++q)
     FitBlock(disparity, unbounded, bx + (q % 2) * half, by + (q / 2) * half, half, options, blocks,
-             out);
+             out, halves);
 }
 
 }  // namespace
@@ -215,16 +284,43 @@ std::vector<BlockFit> FitBlocks(const cv::Mat& disparity, int size, const PlaneF
   // appended after the upper's: the same fits in the same order.
   constexpr int kThreadedMinBlocks = 256;
   const int rows = disparity.rows / size;
-  std::vector<BlockFit> out, lower;
-  ForHalves(rows, rows * (disparity.cols / size) >= kThreadedMinBlocks,
-            [&](size_t first, size_t end) {
-              std::vector<BlockFit>* fits = first == 0 ? &out : &lower;
-              for (int row = static_cast<int>(first); row < static_cast<int>(end); ++row)
-                for (int bx = 0; bx + size <= disparity.cols; bx += size)
-                  if (!keep || keep(bx, row * size, size))
-                    FitBlock(disparity, unbounded, bx, row * size, size, options, blocks, fits);
-            });
+  std::vector<BlockFit> out, lower, halves, lower_halves;
+  ForHalves(
+      rows, rows * (disparity.cols / size) >= kThreadedMinBlocks, [&](size_t first, size_t end) {
+        std::vector<BlockFit>* fits = first == 0 ? &out : &lower;
+        std::vector<BlockFit>* cut = first == 0 ? &halves : &lower_halves;
+        for (int row = static_cast<int>(first); row < static_cast<int>(end); ++row)
+          for (int bx = 0; bx + size <= disparity.cols; bx += size)
+            if (!keep || keep(bx, row * size, size))
+              FitBlock(disparity, unbounded, bx, row * size, size, options, blocks, fits, cut);
+      });
   out.insert(out.end(), lower.begin(), lower.end());
+  halves.insert(halves.end(), lower_halves.begin(), lower_halves.end());
+  if (halves.empty()) return out;
+  // A half is kept where a whole block beside its block (left, right, above
+  // or below) has a plane within half_agreement fit tolerances of its own at
+  // each of its footprint's corners: it extends a surface found whole.
+  std::map<std::pair<int, int>, const BlockFit*> whole;
+  for (const BlockFit& b : out)
+    if (b.size == size) whole.emplace(std::make_pair(b.x, b.y), &b);
+  const double agreement_px = blocks.half_agreement * options.fit_tolerance_px;
+  std::vector<BlockFit> extending;
+  for (const BlockFit& h : halves) {
+    const int nx[4] = {h.x - size, h.x + size, h.x, h.x};
+    const int ny[4] = {h.y, h.y, h.y - size, h.y + size};
+    for (int k = 0; k < 4; ++k) {
+      const auto it = whole.find({nx[k], ny[k]});
+      if (it == whole.end()) continue;
+      double worst = 0;
+      for (const Eigen::Vector2d& c : h.corners)
+        worst = std::max(worst, std::abs(it->second->fit(c.x(), c.y()) - h.fit(c.x(), c.y())));
+      if (worst <= agreement_px) {
+        extending.push_back(h);
+        break;
+      }
+    }
+  }
+  out.insert(out.end(), extending.begin(), extending.end());
   return out;
 }
 

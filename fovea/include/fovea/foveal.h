@@ -86,6 +86,11 @@ struct FovealOptions {
   /// on matches whose windows overlap, and beside an edge on windows that
   /// straddle it. 16 with 32-pixel peripheral patches: never split.
   int periphery_min_block_px = 16;
+  /// Beyond the paper (issue 19): at the peripheral levels, a block that is
+  /// not whole and is split no further is tried as two halves, each kept
+  /// where a whole block beside it agrees with its plane within this many
+  /// fit tolerances (BlockOptions::half_agreement); 0: none.
+  double periphery_half_agreement = 0;
   /// Beyond the paper (issue 20): tessellate, match and triangulate in the
   /// pair's fixation frame (ToFixationFrame: both cameras turned virtually
   /// so that the rows of a tilted verged pair no longer twist against each

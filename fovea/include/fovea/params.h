@@ -214,6 +214,13 @@ inline constexpr ParamSpec kFovealPeripheryMinBlockPx{
     "matching window rests on matches whose windows overlap, and beside a depth edge on windows "
     "that straddle it)",
     2, 64};
+inline constexpr ParamSpec kFovealPeripheryHalfAgreement{
+    "foveal.periphery_half_agreement",
+    "beyond the paper: a peripheral block that is not whole and is split no further is cut in two "
+    "halves; a half whole on its own becomes a patch where a whole block beside it has a plane "
+    "within this many fit tolerances of the half's at its corners (it extends a surface found "
+    "whole up to a depth edge; 0 = no halves)",
+    0, 10};
 inline constexpr ParamSpec kFovealClipToInliers{
     "foveal.clip_to_inliers",
     "beyond the paper: a block's patch covers only its inliers' bounding box, not the whole "

@@ -171,6 +171,18 @@ struct BlockOptions {
   /// corner. The same footprint as the box where the inliers fill a
   /// rectangle.
   bool clip_diagonals = false;
+  /// Beyond the paper (issue 19): with this > 0, a block that is not whole
+  /// and is split no further (its quarters would be under min_block_px) is
+  /// cut in two halves, side by side and one above the other. A half whole
+  /// by the rule above (its own fill, outliers and four quadrants; its
+  /// footprint its inliers' box) becomes a plane where a whole block beside
+  /// its block (left, right, above or below) has a plane within this many
+  /// fit tolerances of its own at each corner of its footprint: the half
+  /// extends, up to a depth edge, a surface found whole next to it. Without
+  /// that neighbour a half is left out: a half-block of coherent matches
+  /// alone is as often a false match (README, issue 19). Of the two cuts,
+  /// the one whose whole halves hold more inliers. 0: no halves.
+  double half_agreement = 0;
 };
 
 /// Planes over the blocks of `size` pixels that tile `disparity` (CV_32F,
