@@ -47,7 +47,7 @@ fovea::Patch Square(double z, double half) {
 TEST_CASE("a plane is fitted exactly from samples on it", "[fovea][patch]") {
   const auto samples = PlaneSamples(0.05, -0.02, 30, 32, 48, 16, 3);
   Eigen::Vector4d box;
-  const auto fit = fovea::FitDisparityPlane(samples, 32, 48, 16, {}, &box);
+  const auto fit = fovea::FitDisparityPlane(samples, 32, 48, 16, 16, {}, &box);
   REQUIRE(fit);
   CHECK(fit->a == Approx(0.05).margin(1e-9));
   CHECK(fit->b == Approx(-0.02).margin(1e-9));
@@ -63,7 +63,7 @@ TEST_CASE("plane fitting drops outliers and rejects mixed or thin support", "[fo
   const int n = int(samples.size());
   samples[5].disparity_px += 15;  // two wrong matches
   samples[40].disparity_px -= 9;
-  const auto fit = fovea::FitDisparityPlane(samples, 0, 0, 16, {});
+  const auto fit = fovea::FitDisparityPlane(samples, 0, 0, 16, 16, {});
   REQUIRE(fit);
   CHECK(fit->support == n - 2);
   CHECK(fit->c == Approx(20).margin(1e-9));
@@ -72,18 +72,43 @@ TEST_CASE("plane fitting drops outliers and rejects mixed or thin support", "[fo
   auto step = PlaneSamples(0, 0, 20, 0, 0, 16, 2);
   for (auto& s : step)
     if (s.x_px > 8) s.disparity_px = 35;
-  CHECK_FALSE(fovea::FitDisparityPlane(step, 0, 0, 16, {}));
+  CHECK_FALSE(fovea::FitDisparityPlane(step, 0, 0, 16, 16, {}));
 
   // Too few samples; all on one row; one quadrant empty.
-  CHECK_FALSE(fovea::FitDisparityPlane(PlaneSamples(0, 0, 20, 0, 0, 16, 8), 0, 0, 16, {}));
+  CHECK_FALSE(fovea::FitDisparityPlane(PlaneSamples(0, 0, 20, 0, 0, 16, 8), 0, 0, 16, 16, {}));
   std::vector<fovea::DisparitySample> row;
   for (int x = 0; x < 16; ++x) row.push_back({double(x), 3, 20});
-  CHECK_FALSE(fovea::FitDisparityPlane(row, 0, 0, 16, {}));
+  CHECK_FALSE(fovea::FitDisparityPlane(row, 0, 0, 16, 16, {}));
   auto corner = PlaneSamples(0, 0, 20, 0, 0, 16, 1);
   corner.erase(std::remove_if(corner.begin(), corner.end(),
                               [](const auto& s) { return s.x_px >= 8 && s.y_px >= 8; }),
                corner.end());
-  CHECK_FALSE(fovea::FitDisparityPlane(corner, 0, 0, 16, {}));
+  CHECK_FALSE(fovea::FitDisparityPlane(corner, 0, 0, 16, 16, {}));
+}
+
+TEST_CASE("a plane is fitted over a rectangle, its quadrants the rectangle's", "[fovea][patch]") {
+  // A 16-px square of samples on one plane; the fit over its right half
+  // (x0 16, width 8, height 16) sees only that half's 128 samples.
+  const auto samples = PlaneSamples(0.05, -0.02, 30, 8, 0, 16, 1);
+  const auto fit = fovea::FitDisparityPlane(samples, 16, 0, 8, 16, {});
+  REQUIRE(fit);
+  CHECK(fit->measurements == 128);
+  CHECK(fit->support == 128);
+  CHECK(fit->a == Approx(0.05).margin(1e-9));
+  CHECK(fit->c == Approx(30).margin(1e-7));
+  // Without the half's lower right quarter (x >= 20, y >= 8) a quadrant of
+  // the rectangle is empty, though the square's lower right holds data.
+  auto corner = samples;
+  corner.erase(std::remove_if(corner.begin(), corner.end(),
+                              [](const auto& s) { return s.x_px >= 20 && s.y_px >= 8; }),
+               corner.end());
+  CHECK(fovea::FitDisparityPlane(corner, 8, 0, 16, 16, {}));
+  CHECK_FALSE(fovea::FitDisparityPlane(corner, 16, 0, 8, 16, {}));
+  fovea::PlaneFitOptions anywhere;
+  anywhere.require_quadrants = false;
+  const auto loose = fovea::FitDisparityPlane(corner, 16, 0, 8, 16, anywhere);
+  REQUIRE(loose);
+  CHECK(loose->measurements == 96);
 }
 
 TEST_CASE("a patch's view angle: 0 face on, growing as it turns edge on", "[fovea][patch]") {

@@ -34,7 +34,8 @@ fovea::PatchMap DepthToPatches(const rig::CameraView& view, const cv::Mat& depth
           if (z > 0) samples.push_back({double(x), double(y), fb_px / z});
         }
       Eigen::Vector4d box;
-      const auto fit = fovea::FitDisparityPlane(samples, bx, by, block_px, fit_options, &box);
+      const auto fit =
+          fovea::FitDisparityPlane(samples, bx, by, block_px, block_px, fit_options, &box);
       if (!fit) continue;
       const double x0 = std::max(bx - 0.5, box(0) - 0.5), y0 = std::max(by - 0.5, box(1) - 0.5);
       const double x1 = std::min(bx + block_px - 0.5, box(2) + 0.5),

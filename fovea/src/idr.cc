@@ -262,8 +262,8 @@ PatchMap PatchesFromDisparities(const std::vector<DisparitySample>& samples,
     for (int bx = 0; bx < bw; ++bx) {
       const double x0 = bx * patch_size_px, y0 = by * patch_size_px;
       Eigen::Vector4d box;
-      const auto fit =
-          FitDisparityPlane(blocks[by * bw + bx], x0, y0, patch_size_px, options, &box);
+      const auto fit = FitDisparityPlane(blocks[by * bw + bx], x0, y0, patch_size_px, patch_size_px,
+                                         options, &box);
       if (!fit) continue;
       // The block, cut back to half a pixel beyond its inliers: inside
       // texture the inliers span the block (crossings on every row); at a

@@ -78,13 +78,14 @@ void PlaneFitOptions::Check(const rig::ParamSpec& min_support_spec,
 }
 
 std::optional<PlaneFit> FitDisparityPlane(const std::vector<DisparitySample>& samples, double x0,
-                                          double y0, double size, const PlaneFitOptions& options,
+                                          double y0, double width, double height,
+                                          const PlaneFitOptions& options,
                                           Eigen::Vector4d* inlier_box, Quad2d* inlier_quad) {
   // Centre coordinates on the block for conditioning.
-  const double cx = x0 + 0.5 * size, cy = y0 + 0.5 * size;
+  const double cx = x0 + 0.5 * width, cy = y0 + 0.5 * height;
   std::vector<const DisparitySample*> in_block;
   for (const auto& s : samples)
-    if (s.x_px >= x0 && s.x_px < x0 + size && s.y_px >= y0 && s.y_px < y0 + size)
+    if (s.x_px >= x0 && s.x_px < x0 + width && s.y_px >= y0 && s.y_px < y0 + height)
       in_block.push_back(&s);
   const int total = static_cast<int>(in_block.size());
   if (total < std::max(3, options.min_support)) return std::nullopt;
@@ -146,6 +147,7 @@ std::optional<PlaneFit> FitDisparityPlane(const std::vector<DisparitySample>& sa
     return std::nullopt;
   if (inlier_box && box(0) > box(2)) return std::nullopt;  // no inlier bounds
   fit.support = static_cast<int>(inliers.size());
+  fit.measurements = total;
   fit.rms_px = std::sqrt(ss / fit.support);
   if (inlier_box) *inlier_box = box;
   if (inlier_quad && extreme[0])
@@ -162,30 +164,24 @@ Quad2d BoxQuad(const Eigen::Vector4d& box) {
 
 namespace {
 
-// The plane of `samples` in the rectangle [x0, x0 + w) x [y0, y0 + h) of
-// block (bx, by, size), if the rectangle is whole by BlockOptions' rule (its
-// inliers fill `fill` of it, at most 5% of its measurements are outliers,
-// inliers in all four of its quadrants); its footprint is its inliers' box.
+// Whether a fit over `area` pixels is whole by BlockOptions' rule: its
+// inliers fill `fill` of it (any fit, with fill 0) and at most 5% of its
+// measurements are outliers (measurements of another surface).
+bool Whole(const std::optional<PlaneFit>& fit, double area, double fill) {
+  if (fill <= 0) return fit.has_value();
+  return fit && fit->support >= fill * area &&
+         fit->measurements - fit->support <= std::max(1.0, 0.05 * double(fit->measurements));
+}
+
+// The plane of `samples` over the rectangle [x0, x0 + w) x [y0, y0 + h) of
+// block (bx, by, size) if the rectangle is whole, its footprint its inliers'
+// box.
 std::optional<BlockFit> WholeHalf(const std::vector<DisparitySample>& samples, int bx, int by,
                                   int size, int x0, int y0, int w, int h,
                                   const PlaneFitOptions& options, double fill) {
-  std::vector<DisparitySample> in;
-  for (const DisparitySample& s : samples)
-    if (s.x_px >= x0 && s.x_px < x0 + w && s.y_px >= y0 && s.y_px < y0 + h) in.push_back(s);
-  // The fit's own quadrants are the block's; the half's are checked below.
-  PlaneFitOptions o = options;
-  o.require_quadrants = false;
   Eigen::Vector4d box;
-  const auto fit = FitDisparityPlane(in, bx, by, size, o, &box, nullptr);
-  if (!fit || fit->support < fill * w * h ||
-      static_cast<int>(in.size()) - fit->support > std::max(1.0, 0.05 * double(in.size())))
-    return std::nullopt;
-  bool quadrant[4] = {false, false, false, false};
-  const double cx = x0 + 0.5 * w - 0.5, cy = y0 + 0.5 * h - 0.5;
-  for (const DisparitySample& s : in)
-    if (std::abs(s.disparity_px - (*fit)(s.x_px, s.y_px)) <= options.fit_tolerance_px)
-      quadrant[(s.x_px >= cx ? 1 : 0) + (s.y_px >= cy ? 2 : 0)] = true;
-  if (!(quadrant[0] && quadrant[1] && quadrant[2] && quadrant[3])) return std::nullopt;
+  const auto fit = FitDisparityPlane(samples, x0, y0, w, h, options, &box, nullptr);
+  if (!Whole(fit, double(w) * h, fill)) return std::nullopt;
   BlockFit half{bx, by, size, *fit};
   half.footprint = Eigen::Vector4d(box(0) - 0.5, box(1) - 0.5, box(2) + 0.5, box(3) + 0.5);
   half.corners = BoxQuad(half.footprint);
@@ -241,17 +237,13 @@ void FitBlock(const cv::Mat& disparity, const cv::Mat& unbounded, int bx, int by
   Eigen::Vector4d box;
   Quad2d quad;
   const bool hull = blocks.clip_to_inliers && blocks.clip_diagonals;
-  const auto fit = FitDisparityPlane(
-      samples, bx, by, size, o, blocks.clip_to_inliers ? &box : nullptr, hull ? &quad : nullptr);
-  // One plane for the whole block when its inliers fill it and it has next
-  // to no outliers (measurements of another surface); else its quarters
-  // are tried, and a smallest block that is not whole is left out.
+  const auto fit =
+      FitDisparityPlane(samples, bx, by, size, size, o, blocks.clip_to_inliers ? &box : nullptr,
+                        hull ? &quad : nullptr);
+  // One plane for the whole block when it is whole; else its quarters are
+  // tried, and a smallest block that is not whole is left out.
   const double fill = blocks.min_fill_share;
-  const int outliers = fit ? static_cast<int>(samples.size()) - fit->support : 0;
-  const bool whole = fill <= 0 ? fit.has_value()
-                               : fit && fit->support >= fill * size * size &&
-                                     outliers <= std::max(1.0, 0.05 * double(samples.size()));
-  if (whole) {
+  if (Whole(fit, double(size) * size, fill)) {
     BlockFit b{bx, by, size, *fit};
     b.footprint = blocks.clip_to_inliers
                       ? Eigen::Vector4d(box(0) - 0.5, box(1) - 0.5, box(2) + 0.5, box(3) + 0.5)

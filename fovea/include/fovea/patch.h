@@ -86,7 +86,8 @@ void SetDepthSigma(Patch* patch, const rig::CameraView& left, const Eigen::Vecto
 struct PlaneFit {
   double a = 0, b = 0, c = 0;
   double rms_px = 0, max_abs_px = 0;
-  int support = 0;
+  int support = 0;       ///< inliers
+  int measurements = 0;  ///< samples in the block, inliers and outliers
   double operator()(double x, double y) const { return a * x + b * y + c; }
 };
 
@@ -121,15 +122,18 @@ struct DisparitySample {
 using Quad2d = std::array<Eigen::Vector2d, 4>;
 
 /// Trimmed least-squares plane over the samples that fall in the block
-/// [x0, x0 + size) x [y0, y0 + size). nullopt if the block has too little
-/// support, degenerate geometry, or too many samples beyond the tolerance.
+/// [x0, x0 + width) x [y0, y0 + height) (a square block, or a half of one).
+/// nullopt if the block has too little support, degenerate geometry, too
+/// many samples beyond the tolerance, or (PlaneFitOptions::
+/// require_quadrants) a quadrant of it without an inlier.
 /// `inlier_box`, if given, receives the extent (x0, y0, x1, y1) of the
 /// inliers that bound (DisparitySample::bounds); nullopt if none does.
 /// `inlier_quad`, if given, receives their diagonal hull: the pixel corners
 /// farthest up-left, up-right, down-right and down-left of them
 /// (BlockOptions::clip_diagonals).
 std::optional<PlaneFit> FitDisparityPlane(const std::vector<DisparitySample>& samples, double x0,
-                                          double y0, double size, const PlaneFitOptions& options,
+                                          double y0, double width, double height,
+                                          const PlaneFitOptions& options,
                                           Eigen::Vector4d* inlier_box = nullptr,
                                           Quad2d* inlier_quad = nullptr);
 
