@@ -194,7 +194,7 @@ TEST_CASE("peripheral blocks are not split below the matching window beside dept
     o.foveal.tessellation.horizontal_disparity_limit_px = 32;
     const fovea::Nl1Matcher matcher;
     const fovea::FixationResult r =
-        fovea::Fixate(sim->rig(), idr.map, {0.09, 0.86, 0.05}, matcher, o);
+        fovea::Fixate(sim->rig(), idr.map, {0.15, 0.91, 0.1}, matcher, o);
     REQUIRE(r.ok);
     Figures f;
     for (const fovea::Patch& p : r.foveal.patches.patches())
@@ -364,6 +364,48 @@ TEST_CASE("at a near fixation the rectified periphery maps what the verged pair'
   CHECK(full.patches >= 3 * rectified.patches);
   CHECK(full.score.median_abs_error_m <= 0.5 * rectified.score.median_abs_error_m);
   CHECK(full.score.gross_errors <= 2);
+}
+
+TEST_CASE("foveal.fovea_edge_erosion_px erodes the fovea's level only", "[foveal][slow]") {
+  // A fixation on three_surfaces' slanted fabric, a depth edge in the
+  // fovea, with the run's options: once with one erosion (3 pixels) at
+  // every level, once with a wider one (5) at the fovea's level. The matches
+  // before erosion are the same, so the wider erosion drops a superset of
+  // the fovea's matches (measured 23 against 2) and leaves the peripheral
+  // levels as they were.
+  sim::SimRigConfig config;
+  config.noise.read_noise_sigma_dn = experiments::kExperimentNoiseSigmaDn;
+  const fovea::Nl1Matcher matcher;
+  auto fixate = [&](int fovea_erosion_px) {
+    auto sim = scenes::LoadScene("three_surfaces", config);
+    const fovea::IdrResult idr = fovea::RunIdr(sim->rig(), {});
+    fovea::FixationOptions o = fovea::ResolvedFixationOptions({});
+    o.foveal.fovea_edge_erosion_px = fovea_erosion_px;
+    o.left_pair_first = false;  // the left pair refuses the block's point (no mutual match)
+    const fovea::FixationResult r =
+        fovea::Fixate(sim->rig(), idr.map, {0.15, 0.91, 0.1}, matcher, o);
+    REQUIRE(r.ok);
+    return r.foveal;
+  };
+  const fovea::FovealResult same = fixate(-1), wider = fixate(5);
+  REQUIRE(same.levels.size() == wider.levels.size());
+  REQUIRE(same.levels.size() >= 2);
+  INFO("level 0 eroded: " << same.levels[0].eroded << " at 3 pixels, " << wider.levels[0].eroded
+                          << " at 5");
+  CHECK(same.levels[0].eroded > 0);
+  CHECK(wider.levels[0].eroded > same.levels[0].eroded);
+  const cv::Mat &d3 = same.disparity_px[0], &d5 = wider.disparity_px[0];
+  REQUIRE(d3.size() == d5.size());
+  int kept_only_wider = 0;
+  for (int y = 0; y < d3.rows; ++y)
+    for (int x = 0; x < d3.cols; ++x)
+      kept_only_wider += std::isfinite(d5.at<float>(y, x)) && !std::isfinite(d3.at<float>(y, x));
+  CHECK(kept_only_wider == 0);
+  for (size_t k = 1; k < same.levels.size(); ++k) {
+    INFO("level " << k);
+    CHECK(wider.levels[k].eroded == same.levels[k].eroded);
+    CHECK(wider.levels[k].patches == same.levels[k].patches);
+  }
 }
 
 TEST_CASE("the fovea keeps its size at any elevation the heads reach", "[foveal][slow][outcome]") {

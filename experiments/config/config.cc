@@ -281,6 +281,7 @@ void AddFovealParams(RunConfig* c, std::vector<ConfigParam>* params) {
                      {&fp::kFovealMapMarginPx, &x.foveal.map_margin_px},
                      {&fp::kFovealCoarseMarginPx, &x.foveal.coarse_margin_px},
                      {&fp::kFovealEdgeErosionPx, &x.foveal.edge_erosion_px},
+                     {&fp::kFovealFoveaEdgeErosionPx, &x.foveal.fovea_edge_erosion_px},
                      {&fp::kFovealEdgeJumpPx, &x.foveal.edge_jump_px},
                      {&fp::kFovealEdgeHolePx, &x.foveal.edge_hole_px},
                      {&fp::kFovealMinFillShare, &x.foveal.blocks.min_fill_share},

@@ -23,6 +23,7 @@ void FovealOptions::Check() const {
   rig::CheckParam(params::kFovealSilentConfidence, silent_confidence);
   rig::CheckParam(params::kFovealSilentCheckLevel, silent_check_level);
   rig::CheckParam(params::kFovealEdgeErosionPx, edge_erosion_px);
+  rig::CheckParam(params::kFovealFoveaEdgeErosionPx, fovea_edge_erosion_px);
   rig::CheckParam(params::kFovealEdgeJumpPx, edge_jump_px);
   rig::CheckParam(params::kFovealEdgeHolePx, edge_hole_px);
   rig::CheckParam(params::kFovealMinFillShare, blocks.min_fill_share);
@@ -696,8 +697,10 @@ FovealResult FovealStereo(const FixationFrame& matched, const Eigen::Vector3d& f
     fig.searched = dm.searched;
     fig.matched = dm.matched - outside_band;
     fig.outside_band = outside_band;
-    fig.eroded =
-        ErodeAtDisparityJumps(options.edge_erosion_px, options.edge_jump_px, &dm.disparity_px);
+    fig.eroded = ErodeAtDisparityJumps(index == 0 && options.fovea_edge_erosion_px >= 0
+                                           ? options.fovea_edge_erosion_px
+                                           : options.edge_erosion_px,
+                                       options.edge_jump_px, &dm.disparity_px);
     if (rectified_periphery && index + 1 == levels)
       MatchRectifiedPeriphery(result.frame, fixation_W, t, index, map, matcher, options, fixation,
                               &result, &fig);

@@ -63,6 +63,11 @@ struct FovealOptions {
   /// patches are fitted (window matching fattens a nearer surface over a
   /// farther one's pixels beside their edge); 0: none. A window's half width.
   int edge_erosion_px = 3;
+  /// Beyond the paper (issue 19): edge_erosion_px at the fovea's level
+  /// (level 0) only, the peripheral levels keeping edge_erosion_px; -1: the
+  /// same at every level (README, issue 19: measured with
+  /// periphery_half_agreement).
+  int fovea_edge_erosion_px = -1;
   double edge_jump_px = 1.5;
   /// Beyond the paper: matches within edge_erosion_px of a row or column run
   /// of at least this many unmatched pixels do not set a patch's footprint

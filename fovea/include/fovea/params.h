@@ -189,6 +189,11 @@ inline constexpr ParamSpec kFovealEdgeErosionPx{
     "foveal.edge_jump_px "
     "smaller are dropped (window matching fattens a nearer surface over its edge; 0 = none)",
     0, 10};
+inline constexpr ParamSpec kFovealFoveaEdgeErosionPx{
+    "foveal.fovea_edge_erosion_px",
+    "beyond the paper: foveal.edge_erosion_px at the fovea's level only (level 0, full "
+    "resolution; the peripheral levels keep foveal.edge_erosion_px); -1 = foveal.edge_erosion_px",
+    -1, 10};
 inline constexpr ParamSpec kFovealEdgeJumpPx{
     "foveal.edge_jump_px", "see foveal.edge_erosion_px: the disparity jump, level pixels", 0.1, 64};
 inline constexpr ParamSpec kFovealEdgeHolePx{
