@@ -178,8 +178,9 @@ struct BlockOptions {
   /// Beyond the paper (issue 19): with this > 0, a block that is not whole
   /// and is split no further (its quarters would be under min_block_px) is
   /// cut in two halves, side by side and one above the other. A half whole
-  /// by the rule above (its own fill, outliers and four quadrants; its
-  /// footprint its inliers' box) becomes a plane where a whole block beside
+  /// by the rule above (its own fill and outliers, and its own four
+  /// quadrants where PlaneFitOptions::require_quadrants; its footprint its
+  /// inliers' box) becomes a plane where a whole block beside
   /// its block (left, right, above or below) has a plane within this many
   /// fit tolerances of its own at each corner of its footprint: the half
   /// extends, up to a depth edge, a surface found whole next to it. Without
