@@ -191,16 +191,18 @@ TEST_CASE(
   // (random:7 seed 0), in the release and the sanitizer builds alike
   // (measured; two_planes seed 1 falls back in one and not the other).
   // cylinder_planes is nearly whole after a few fixations, so one of them
-  // stalls early (seed 2: the first fallback at the fourth, in the release
-  // build); six leave room for another path in the sanitizer build. The
-  // cases were found with the two-camera placements tried first
+  // stalls early (seed 3: the first fallback at the fifth attempt, in the
+  // release build, since the defaults of 2026-12-07; seed 2, whose first
+  // came at the fourth before, has none in its first twelve now); eight
+  // leave room for another path in the sanitizer build. The cases were
+  // found with the two-camera placements tried first
   // (foveal.left_pair_first=false), whose paths reach them.
   struct Case {
     std::string scene, seed, fallback, fixations;
   };
   for (const auto& [scene, seed, fallback, fixations] :
        {Case{"random:4", "0", "mapped", "3"}, Case{"random:7", "0", "foveal", "3"},
-        Case{"cylinder_planes", "2", "stalled", "6"}}) {
+        Case{"cylinder_planes", "3", "stalled", "8"}}) {
     INFO(scene << " seed " << seed << ", " << fallback);
     const fs::path with = Out("fallback"), without = Out("nofallback");
     const std::string run = "--scene " + scene + " --seed " + seed + " --fixations " + fixations +

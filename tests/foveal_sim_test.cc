@@ -183,6 +183,10 @@ TEST_CASE("peripheral blocks are not split below the matching window beside dept
     const fovea::IdrResult idr = fovea::RunIdr(sim->rig(), {});
     fovea::FixationOptions o = fovea::ResolvedFixationOptions({});  // the run's
     o.foveal.periphery_min_block_px = periphery_min_block_px;
+    // Whole blocks or quarters only: the halves that extend a whole
+    // neighbour (on by default since 2026-12-07) have their own test in
+    // tests/patch_test.cc.
+    o.foveal.periphery_half_agreement = 0;
     // The two cameras, as measured (the left camera paired with itself
     // finds no mutual match at this point and refuses it).
     o.left_pair_first = false;
