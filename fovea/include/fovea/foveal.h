@@ -63,9 +63,11 @@ struct FovealOptions {
   /// patches are fitted (window matching fattens a nearer surface over a
   /// farther one's pixels beside their edge); 0: none. A window's half width.
   int edge_erosion_px = 3;
-  /// Beyond the paper (issue 19): edge_erosion_px at the fovea's level
-  /// (level 0) only, the peripheral levels keeping edge_erosion_px; -1: the
-  /// same at every level. 4 with periphery_half_agreement 2: over the
+  /// Beyond the paper (issue 19): the erosion beside disparity jumps at the
+  /// fovea's level (level 0) only, the peripheral levels keeping
+  /// edge_erosion_px; -1: the same at every level. The margin beside
+  /// unmatched runs (edge_hole_px) keeps edge_erosion_px at every level,
+  /// the fovea's too. 4 with periphery_half_agreement 2: over the
   /// accuracy benchmark the two together lifted good coverage and kept
   /// every accuracy line (README, "The map's trust").
   int fovea_edge_erosion_px = 4;

@@ -191,8 +191,10 @@ inline constexpr ParamSpec kFovealEdgeErosionPx{
     0, 10};
 inline constexpr ParamSpec kFovealFoveaEdgeErosionPx{
     "foveal.fovea_edge_erosion_px",
-    "beyond the paper: foveal.edge_erosion_px at the fovea's level only (level 0, full "
-    "resolution; the peripheral levels keep foveal.edge_erosion_px); -1 = foveal.edge_erosion_px",
+    "beyond the paper: the erosion beside disparity jumps of foveal.edge_erosion_px, at the "
+    "fovea's level only (level 0, full resolution; the peripheral levels, and the margin beside "
+    "unmatched runs of foveal.edge_hole_px at every level, keep foveal.edge_erosion_px); -1 = "
+    "foveal.edge_erosion_px",
     -1, 10};
 inline constexpr ParamSpec kFovealEdgeJumpPx{
     "foveal.edge_jump_px", "see foveal.edge_erosion_px: the disparity jump, level pixels", 0.1, 64};
