@@ -147,6 +147,43 @@ TEST_CASE("graded suppression: peripheral data weighs between foveal data and th
   CHECK(paper.at<double>(60, 80) == Approx(paper.at<double>(60, 150)));
 }
 
+TEST_CASE("hole width: thin strips beside mapped data weigh less than the inside of wide holes",
+          "[fovea][selection]") {
+  // f = 150 px, 1 m away: column x lies at (x - 80) / 150 m. Peripheral data
+  // on columns 0-80 and 86-110; a hole 6 columns wide between them and one
+  // from column 110 to the image's edge.
+  fovea::PatchMap map;
+  map.Add(Square(-1, 0, -1, 1, 1.0, fovea::PatchLevel::kPeripheral));
+  map.Add(Square(0.04, 0.2, -1, 1, 1.0, fovea::PatchLevel::kPeripheral));
+  const fovea::SelectionContext c = fovea::SelectionContext::Make(HalfTextured(), View(), map);
+  REQUIRE(c.map_level.at<signed char>(60, 83) == -1);
+  REQUIRE(c.map_level.at<signed char>(60, 150) == -1);
+  fovea::CriteriaOptions o;  // peripheral 0.3
+  // The paper's rule: every hole weighs the same.
+  const cv::Mat paper = fovea::LocalSuppression(o).Evaluate(c);
+  CHECK(paper.at<double>(60, 83) == Approx(paper.at<double>(60, 150)));
+  CHECK(paper.at<double>(60, 40) == Approx(0.3 * paper.at<double>(60, 150)));
+  o.hole_width_px = 10;
+  const cv::Mat w = fovea::LocalSuppression(o).Evaluate(c);
+  const double peripheral = w.at<double>(60, 40);
+  REQUIRE(peripheral > 0);
+  // 40 columns inside the wide hole: the full weight, 1 / 0.3 of peripheral
+  // data's. The strip's pixels lie at most 3-4 columns from mapped data:
+  // above peripheral data, well below the full weight. At the hole's edge
+  // the weight is close to peripheral data's, and it rises inwards.
+  CHECK(w.at<double>(60, 150) == Approx(peripheral / 0.3));
+  for (int x = 81; x <= 85; ++x) {
+    INFO("column " << x);
+    CHECK(w.at<double>(60, x) > peripheral * 1.1);
+    CHECK(w.at<double>(60, x) < peripheral * (0.3 + 0.7 * 0.45) / 0.3);
+  }
+  CHECK(w.at<double>(60, 111) < peripheral * (0.3 + 0.7 * 0.25) / 0.3);
+  CHECK(w.at<double>(60, 111) < w.at<double>(60, 115));
+  CHECK(w.at<double>(60, 115) < w.at<double>(60, 119));
+  CHECK(w.at<double>(60, 125) == Approx(peripheral / 0.3));
+  CHECK(cv::sum(w)[0] == Approx(1.0));
+}
+
 TEST_CASE("local suppression: zero weight at earlier fixations, low weight around them",
           "[fovea][selection]") {
   fovea::PatchMap map;
@@ -236,11 +273,13 @@ TEST_CASE("selection at a reduced resolution: the same rays, sizes in full-resol
   }
   fovea::SelectionOptions selection;
   fovea::CriteriaOptions criteria;
+  criteria.hole_width_px = 16;
   fovea::AtResolutionLevel(1, &selection, &criteria);
   CHECK(selection.border_px == 8);
   CHECK(selection.fovea_size_px == 64);
   CHECK(criteria.gradient_blur_px == 1.0);
   CHECK(criteria.proximity_2d_scale_px == 160);
+  CHECK(criteria.hole_width_px == 8);
   selection.fovea_size_px = 8;  // the smallest allowed stays
   fovea::AtResolutionLevel(2, &selection, &criteria);
   CHECK(selection.fovea_size_px == 8);

@@ -355,6 +355,7 @@ void AddDdrParams(RunConfig* c, std::vector<ConfigParam>* params) {
           {&fp::kCriteriaSuppressionRadiusM, &f.criteria.suppression_radius_m},
           {&fp::kCriteriaPeripheralWeight, &f.criteria.peripheral_weight},
           {&fp::kCriteriaRevisitRadiusM, &f.criteria.revisit_radius_m},
+          {&fp::kCriteriaHoleWidthPx, &f.criteria.hole_width_px},
           {&fp::kCriteriaProximity2dScalePx, &f.criteria.proximity_2d_scale_px},
           {&fp::kCriteriaProximity3dLow, &f.criteria.proximity_3d_low},
           {&ep::kStaticBaselineM, &c->static_baseline_m},

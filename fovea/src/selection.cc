@@ -195,6 +195,24 @@ cv::Mat LocalSuppression::Evaluate(const SelectionContext& c) const {
       if (level[x] == static_cast<signed char>(PatchLevel::kPeripheral)) wp[x] = peripheral_;
     }
   }
+  if (hole_width_ > 0) {
+    // A hole pixel's distance to the nearest mapped pixel (the image's edge
+    // is not mapped data: a hole reaching it is as wide as it is inside).
+    const cv::Mat holes = c.map_level < 0;
+    const int n_holes = cv::countNonZero(holes);
+    if (n_holes > 0 && n_holes < static_cast<int>(holes.total())) {
+      cv::Mat distance;
+      cv::distanceTransform(holes, distance, cv::DIST_L2, cv::DIST_MASK_5);
+      for (int y = 0; y < w.rows; ++y) {
+        const signed char* level = c.map_level.ptr<signed char>(y);
+        const float* d = distance.ptr<float>(y);
+        double* wp = w.ptr<double>(y);
+        for (int x = 0; x < w.cols; ++x)
+          if (level[x] < 0)
+            wp[x] = peripheral_ + (1 - peripheral_) * std::min(1.0, d[x] / hole_width_);
+      }
+    }
+  }
   // Each point suppresses only the pixels whose map points lie within the
   // radius: visiting just the pixels it can reach keeps the cost per
   // fixation from growing with the fixations made (0 within the revisit
@@ -278,6 +296,7 @@ void CriteriaOptions::Check() const {
   rig::CheckParam(params::kCriteriaSuppressionRadiusM, suppression_radius_m);
   rig::CheckParam(params::kCriteriaPeripheralWeight, peripheral_weight);
   rig::CheckParam(params::kCriteriaRevisitRadiusM, revisit_radius_m);
+  rig::CheckParam(params::kCriteriaHoleWidthPx, hole_width_px);
   rig::CheckParam(params::kCriteriaProximity2dScalePx, proximity_2d_scale_px);
   rig::CheckParam(params::kCriteriaProximity3dLow, proximity_3d_low);
 }
@@ -371,6 +390,7 @@ void AtResolutionLevel(int level, SelectionOptions* selection, CriteriaOptions* 
   selection->fovea_size_px = scaled(selection->fovea_size_px, params::kSelectionFoveaSizePx.lo);
   criteria->gradient_blur_px *= s;
   criteria->proximity_2d_scale_px *= s;
+  criteria->hole_width_px *= s;
 }
 
 rig::CameraView ReducedView(const rig::CameraView& view, int level) {

@@ -409,6 +409,11 @@ inline constexpr ParamSpec kCriteriaRevisitRadiusM{
     "where the servo "
     "settled farther than this from it), metres",
     0, 1};
+inline constexpr ParamSpec kCriteriaHoleWidthPx{
+    "criteria.hole_width_px",
+    "local suppression's weight on a hole rises from criteria.peripheral_weight at its edge to 1 "
+    "this far inside it, pixels (0: every hole weighs 1)",
+    0, 1000};
 inline constexpr ParamSpec kCriteriaProximity2dScalePx{
     "criteria.proximity_2d_scale_px", "2D proximity's scale s in exp(-r / s), pixels", 1, 1e9};
 inline constexpr ParamSpec kCriteriaProximity3dLow{

@@ -93,6 +93,12 @@ struct CriteriaOptions {
   double peripheral_weight = 0.3;      ///< local suppression's weight on peripheral data (paper: 1)
   /// Local suppression's weight is 0 this close to an earlier fixation point.
   double revisit_radius_m = 0.03;
+  /// Beyond the paper: local suppression's weight on a hole (a pixel the map
+  /// is silent at) rises from peripheral_weight at the hole's edge to 1 this
+  /// far inside it, pixels (its distance to the nearest mapped pixel), so the
+  /// eye prefers the inside of wide holes to thin strips beside mapped data.
+  /// 0: every hole weighs 1 (the paper's rule).
+  double hole_width_px = 0;
   double proximity_2d_scale_px = 320;
   double proximity_3d_low = 0.1;  ///< 3D proximity's weight outside the Z_T band
   void Check() const;             ///< throws rig::InputError naming the key (fovea/params.h)
@@ -131,19 +137,21 @@ class GradientAttraction : public FixationCriterion {
 /// point the weight is 0: the scene is static, and a second look at the same
 /// point from the same rig sees what the first saw (a fixation at a depth
 /// edge, whose fovea yields nothing, kept drawing the eye back with any
-/// weight above 0).
+/// weight above 0). With `hole_width_px` set, a hole's weight grades from
+/// peripheral_weight at its edge to 1 that far inside it.
 class LocalSuppression : public FixationCriterion {
  public:
   explicit LocalSuppression(const CriteriaOptions& o)
       : low_(o.suppressed_weight),
         radius_(o.suppression_radius_m),
         peripheral_(o.peripheral_weight),
-        revisit_(o.revisit_radius_m) {}
+        revisit_(o.revisit_radius_m),
+        hole_width_(o.hole_width_px) {}
   std::string Name() const override { return "suppression"; }
   cv::Mat Evaluate(const SelectionContext& context) const override;
 
  private:
-  double low_, radius_, peripheral_, revisit_;
+  double low_, radius_, peripheral_, revisit_, hole_width_;
 };
 
 /// exp(-r / s), r the distance from the image centre in pixels.
@@ -246,8 +254,8 @@ struct SelectionOptions {
 
 /// The options for choosing in a view reduced 2^level times: their pixel
 /// sizes (the border, the fovea's size, the gradient's blur and 2D
-/// proximity's scale) divided by 2^level, the integer ones rounded and kept
-/// at least their smallest allowed value.
+/// proximity's scale, local suppression's hole width) divided by 2^level,
+/// the integer ones rounded and kept at least their smallest allowed value.
 void AtResolutionLevel(int level, SelectionOptions* selection, CriteriaOptions* criteria);
 
 /// `view` reduced 2^level times in each direction: the same rays through
