@@ -147,7 +147,7 @@ TEST_CASE("graded suppression: peripheral data weighs between foveal data and th
   CHECK(paper.at<double>(60, 80) == Approx(paper.at<double>(60, 150)));
 }
 
-TEST_CASE("hole width: thin strips beside mapped data weigh less than the inside of wide holes",
+TEST_CASE("hole width: a hole's weight grades from its edge inwards, either way",
           "[fovea][selection]") {
   // f = 150 px, 1 m away: column x lies at (x - 80) / 150 m. Peripheral data
   // on columns 0-80 and 86-110; a hole 6 columns wide between them and one
@@ -158,7 +158,7 @@ TEST_CASE("hole width: thin strips beside mapped data weigh less than the inside
   const fovea::SelectionContext c = fovea::SelectionContext::Make(HalfTextured(), View(), map);
   REQUIRE(c.map_level.at<signed char>(60, 83) == -1);
   REQUIRE(c.map_level.at<signed char>(60, 150) == -1);
-  fovea::CriteriaOptions o;  // peripheral 0.3
+  fovea::CriteriaOptions o;  // peripheral 0.3; a hole: 0.3 at its edge, 1 inside
   // The paper's rule: every hole weighs the same.
   const cv::Mat paper = fovea::LocalSuppression(o).Evaluate(c);
   CHECK(paper.at<double>(60, 83) == Approx(paper.at<double>(60, 150)));
@@ -182,6 +182,19 @@ TEST_CASE("hole width: thin strips beside mapped data weigh less than the inside
   CHECK(w.at<double>(60, 115) < w.at<double>(60, 119));
   CHECK(w.at<double>(60, 125) == Approx(peripheral / 0.3));
   CHECK(cv::sum(w)[0] == Approx(1.0));
+  // The other way: the edges of holes weigh 1, their insides 0.3, as much
+  // as peripheral data.
+  o.hole_edge_weight = 1;
+  o.hole_inside_weight = 0.3;
+  const cv::Mat edges = fovea::LocalSuppression(o).Evaluate(c);
+  const double p = edges.at<double>(60, 40);
+  CHECK(edges.at<double>(60, 150) == Approx(p));
+  for (int x = 81; x <= 85; ++x) {
+    INFO("column " << x);
+    CHECK(edges.at<double>(60, x) > p * (1 - 0.7 * 0.45) / 0.3);
+    CHECK(edges.at<double>(60, x) < p * (1 - 0.7 * 0.05) / 0.3);
+  }
+  CHECK(edges.at<double>(60, 111) > edges.at<double>(60, 115));
 }
 
 TEST_CASE("local suppression: zero weight at earlier fixations, low weight around them",

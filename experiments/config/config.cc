@@ -356,6 +356,8 @@ void AddDdrParams(RunConfig* c, std::vector<ConfigParam>* params) {
           {&fp::kCriteriaPeripheralWeight, &f.criteria.peripheral_weight},
           {&fp::kCriteriaRevisitRadiusM, &f.criteria.revisit_radius_m},
           {&fp::kCriteriaHoleWidthPx, &f.criteria.hole_width_px},
+          {&fp::kCriteriaHoleEdgeWeight, &f.criteria.hole_edge_weight},
+          {&fp::kCriteriaHoleInsideWeight, &f.criteria.hole_inside_weight},
           {&fp::kCriteriaProximity2dScalePx, &f.criteria.proximity_2d_scale_px},
           {&fp::kCriteriaProximity3dLow, &f.criteria.proximity_3d_low},
           {&ep::kStaticBaselineM, &c->static_baseline_m},

@@ -209,7 +209,7 @@ cv::Mat LocalSuppression::Evaluate(const SelectionContext& c) const {
         double* wp = w.ptr<double>(y);
         for (int x = 0; x < w.cols; ++x)
           if (level[x] < 0)
-            wp[x] = peripheral_ + (1 - peripheral_) * std::min(1.0, d[x] / hole_width_);
+            wp[x] = hole_edge_ + (hole_inside_ - hole_edge_) * std::min(1.0, d[x] / hole_width_);
       }
     }
   }
@@ -297,6 +297,8 @@ void CriteriaOptions::Check() const {
   rig::CheckParam(params::kCriteriaPeripheralWeight, peripheral_weight);
   rig::CheckParam(params::kCriteriaRevisitRadiusM, revisit_radius_m);
   rig::CheckParam(params::kCriteriaHoleWidthPx, hole_width_px);
+  rig::CheckParam(params::kCriteriaHoleEdgeWeight, hole_edge_weight);
+  rig::CheckParam(params::kCriteriaHoleInsideWeight, hole_inside_weight);
   rig::CheckParam(params::kCriteriaProximity2dScalePx, proximity_2d_scale_px);
   rig::CheckParam(params::kCriteriaProximity3dLow, proximity_3d_low);
 }

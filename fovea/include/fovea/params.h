@@ -411,9 +411,19 @@ inline constexpr ParamSpec kCriteriaRevisitRadiusM{
     0, 1};
 inline constexpr ParamSpec kCriteriaHoleWidthPx{
     "criteria.hole_width_px",
-    "local suppression's weight on a hole rises from criteria.peripheral_weight at its edge to 1 "
-    "this far inside it, pixels (0: every hole weighs 1)",
+    "local suppression's weight on a hole goes from criteria.hole_edge_weight at its edge to "
+    "criteria.hole_inside_weight this far inside it, pixels (0: every hole weighs 1)",
     0, 1000};
+inline constexpr ParamSpec kCriteriaHoleEdgeWeight{
+    "criteria.hole_edge_weight",
+    "local suppression's weight at a hole's edge, beside mapped data (with "
+    "criteria.hole_width_px)",
+    0, 1};
+inline constexpr ParamSpec kCriteriaHoleInsideWeight{
+    "criteria.hole_inside_weight",
+    "local suppression's weight criteria.hole_width_px or more inside a hole (with "
+    "criteria.hole_width_px)",
+    0, 1};
 inline constexpr ParamSpec kCriteriaProximity2dScalePx{
     "criteria.proximity_2d_scale_px", "2D proximity's scale s in exp(-r / s), pixels", 1, 1e9};
 inline constexpr ParamSpec kCriteriaProximity3dLow{

@@ -94,11 +94,14 @@ struct CriteriaOptions {
   /// Local suppression's weight is 0 this close to an earlier fixation point.
   double revisit_radius_m = 0.03;
   /// Beyond the paper: local suppression's weight on a hole (a pixel the map
-  /// is silent at) rises from peripheral_weight at the hole's edge to 1 this
-  /// far inside it, pixels (its distance to the nearest mapped pixel), so the
-  /// eye prefers the inside of wide holes to thin strips beside mapped data.
-  /// 0: every hole weighs 1 (the paper's rule).
+  /// is silent at) goes from hole_edge_weight at the hole's edge (beside
+  /// mapped data) to hole_inside_weight this far inside it, pixels (the
+  /// pixel's distance to the nearest mapped pixel), linearly, and stays
+  /// there further in. 0: every hole weighs 1 (the paper's rule).
+  /// Measured and not kept, both ways (README, "The map's trust").
   double hole_width_px = 0;
+  double hole_edge_weight = 0.3;
+  double hole_inside_weight = 1;
   double proximity_2d_scale_px = 320;
   double proximity_3d_low = 0.1;  ///< 3D proximity's weight outside the Z_T band
   void Check() const;             ///< throws rig::InputError naming the key (fovea/params.h)
@@ -138,7 +141,7 @@ class GradientAttraction : public FixationCriterion {
 /// point from the same rig sees what the first saw (a fixation at a depth
 /// edge, whose fovea yields nothing, kept drawing the eye back with any
 /// weight above 0). With `hole_width_px` set, a hole's weight grades from
-/// peripheral_weight at its edge to 1 that far inside it.
+/// hole_edge_weight at its edge to hole_inside_weight that far inside it.
 class LocalSuppression : public FixationCriterion {
  public:
   explicit LocalSuppression(const CriteriaOptions& o)
@@ -146,12 +149,14 @@ class LocalSuppression : public FixationCriterion {
         radius_(o.suppression_radius_m),
         peripheral_(o.peripheral_weight),
         revisit_(o.revisit_radius_m),
-        hole_width_(o.hole_width_px) {}
+        hole_width_(o.hole_width_px),
+        hole_edge_(o.hole_edge_weight),
+        hole_inside_(o.hole_inside_weight) {}
   std::string Name() const override { return "suppression"; }
   cv::Mat Evaluate(const SelectionContext& context) const override;
 
  private:
-  double low_, radius_, peripheral_, revisit_, hole_width_;
+  double low_, radius_, peripheral_, revisit_, hole_width_, hole_edge_, hole_inside_;
 };
 
 /// exp(-r / s), r the distance from the image centre in pixels.
