@@ -231,6 +231,12 @@ code=$?
   fail "a second sweep on a held folder: exit $code: ${err:0:300}"
 wait "$holder" || fail "the holding sweep failed: $(tail -2 "$work/held.log")"
 expect 2 "exists and is not empty" collect "$t/full" "$work/held"
+# fovea compare: two sweep folders, pairs of runs of one method
+expect 2 "is not a sweep folder" compare "$t/full" "$work/held"
+expect 2 "no static_sgbm runs pair up" compare "$work/held" "$work/held" --method static_sgbm
+out=$("$fovea" compare "$work/held" "$work/held" 2>&1)
+[[ $out == *"1 pair of fovea runs by scene and seed"* && $out == *"good_coverage"* ]] ||
+  fail "compare of a sweep with itself: ${out:0:300}"
 
 # ---- good inputs that used to fail -------------------------------------------
 # [2] a trailing slash names the folder

@@ -18,6 +18,7 @@
 
 #include "commands.h"
 #include "experiments/config/sweep.h"
+#include "experiments/output/compare.h"
 #include "experiments/output/output.h"
 #include "experiments/output/report.h"
 #include "experiments/output/run_folder.h"
@@ -428,6 +429,34 @@ void AddSweepCommands(CLI::App& app, std::function<int()>* run) {
     *run = [report_dir] {
       const std::string page = WriteReport(*report_dir);
       std::fprintf(stderr, "fovea report: %s\n", page.c_str());
+      return 0;
+    };
+  });
+
+  struct CompareArgs {
+    std::string base, variant, method = "fovea";
+    bool json = false;
+  };
+  auto cmp_args = std::make_shared<CompareArgs>();
+  CLI::App* cmp = app.add_subcommand(
+      "compare",
+      "pair two sweeps' runs by scene and seed: each figure's paired change and issue 19's lines");
+  cmp->add_option("base", cmp_args->base, "sweep folder before the change")->required();
+  cmp->add_option("variant", cmp_args->variant, "sweep folder after it")->required();
+  cmp->add_option("--method", cmp_args->method,
+                  "the runs to pair: fovea, or a baseline (static_sgbm, deterministic)")
+      ->capture_default_str();
+  cmp->add_flag("--json", cmp_args->json, "one JSON object on stdout");
+  cmp->callback([cmp_args, run] {
+    *run = [cmp_args] {
+      const CompareArgs& a = *cmp_args;
+      const Comparison c = Compare(SweepSummaries(a.base), SweepSummaries(a.variant), a.method);
+      if (c.pairs == 0)
+        throw UsageError("no " + rig::ClipForMessage(a.method) +
+                         " runs pair up by scene and seed between '" + rig::ClipForMessage(a.base) +
+                         "' and '" + rig::ClipForMessage(a.variant) + "'");
+      const std::string out = a.json ? ComparisonJson(c).dump(1) + "\n" : ComparisonText(c);
+      std::fwrite(out.data(), 1, out.size(), stdout);
       return 0;
     };
   });

@@ -22,6 +22,18 @@
 
 namespace experiments {
 namespace fs = std::filesystem;
+
+double SummaryNumber(const nlohmann::json& summary, const std::string& dotted) {
+  const nlohmann::json* p = &summary;
+  std::stringstream ss(dotted);
+  std::string part;
+  while (std::getline(ss, part, '.')) {
+    if (!p->is_object() || !p->contains(part)) return std::nan("");
+    p = &(*p)[part];
+  }
+  return p->is_number() ? p->get<double>() : std::nan("");
+}
+
 namespace {
 
 std::string Base64(const std::string& bytes) {
@@ -84,23 +96,12 @@ const char* kStyle =
     "figcaption{font-size:13px;color:#555}.plots{display:flex;flex-wrap:wrap;gap:1em}"
     "h2{border-bottom:1px solid #ddd;padding-bottom:4px}</style>\n";
 
-double Num(const nlohmann::json& j, const std::string& dotted) {
-  const nlohmann::json* p = &j;
-  std::stringstream ss(dotted);
-  std::string part;
-  while (std::getline(ss, part, '.')) {
-    if (!p->is_object() || !p->contains(part)) return std::nan("");
-    p = &(*p)[part];
-  }
-  return p->is_number() ? p->get<double>() : std::nan("");
-}
-
 // A figure per row of `rows` (summary key, label) that the summary holds.
 std::string FigureTable(const nlohmann::json& s,
                         const std::vector<std::pair<std::string, std::string>>& rows) {
   std::string h = "<table>";
   for (const auto& [key, label] : rows) {
-    const double v = Num(s, key);
+    const double v = SummaryNumber(s, key);
     if (std::isfinite(v))
       h += "<tr><th class=l>" + Html(label) + "</th><td>" + Fmt(v) + "</td></tr>";
   }
@@ -115,10 +116,10 @@ std::string LevelAndSurfaceTables(const nlohmann::json& s) {
          "m</th><th>median "
          "error, steps</th><th>RMSE, m</th></tr>";
     for (auto it = s["by_level"].begin(); it != s["by_level"].end(); ++it)
-      h += "<tr><td class=l>" + it.key() + "</td><td>" + Fmt(Num(it.value(), "share")) +
-           "</td><td>" + Fmt(Num(it.value(), "median_abs_error_m")) + "</td><td>" +
-           Fmt(Num(it.value(), "median_error_steps")) + "</td><td>" +
-           Fmt(Num(it.value(), "rmse_m")) + "</td></tr>";
+      h += "<tr><td class=l>" + it.key() + "</td><td>" + Fmt(SummaryNumber(it.value(), "share")) +
+           "</td><td>" + Fmt(SummaryNumber(it.value(), "median_abs_error_m")) + "</td><td>" +
+           Fmt(SummaryNumber(it.value(), "median_error_steps")) + "</td><td>" +
+           Fmt(SummaryNumber(it.value(), "rmse_m")) + "</td></tr>";
     h += "</table>\n";
   }
   if (s.contains("by_surface")) {
@@ -127,9 +128,10 @@ std::string LevelAndSurfaceTables(const nlohmann::json& s) {
          "<th>median error, m</th></tr>";
     for (auto it = s["by_surface"].begin(); it != s["by_surface"].end(); ++it)
       h += "<tr><td class=l>" + Html(it.key()) + "</td><td>" +
-           Fmt(Num(it.value(), "pixels"), "%.0f") + "</td><td>" + Fmt(Num(it.value(), "coverage")) +
-           "</td><td>" + Fmt(Num(it.value(), "foveal_coverage")) + "</td><td>" +
-           Fmt(Num(it.value(), "median_abs_error_m")) + "</td></tr>";
+           Fmt(SummaryNumber(it.value(), "pixels"), "%.0f") + "</td><td>" +
+           Fmt(SummaryNumber(it.value(), "coverage")) + "</td><td>" +
+           Fmt(SummaryNumber(it.value(), "foveal_coverage")) + "</td><td>" +
+           Fmt(SummaryNumber(it.value(), "median_abs_error_m")) + "</td></tr>";
     h += "</table>\n";
   }
   return h;
@@ -145,10 +147,10 @@ std::string FixationCurves(const std::string& dir) {
     if (!r.value("ok", false)) continue;
     const double f = r.at("fixation").get<double>();
     const nlohmann::json& sc = r.at("score");
-    cov.x.push_back(f), cov.y.push_back(Num(sc, "coverage"));
-    fov.x.push_back(f), fov.y.push_back(Num(sc, "foveal_coverage"));
-    med.x.push_back(f), med.y.push_back(1e3 * Num(sc, "median_abs_error_m"));
-    rmse.x.push_back(f), rmse.y.push_back(1e3 * Num(sc, "rmse_m"));
+    cov.x.push_back(f), cov.y.push_back(SummaryNumber(sc, "coverage"));
+    fov.x.push_back(f), fov.y.push_back(SummaryNumber(sc, "foveal_coverage"));
+    med.x.push_back(f), med.y.push_back(1e3 * SummaryNumber(sc, "median_abs_error_m"));
+    rmse.x.push_back(f), rmse.y.push_back(1e3 * SummaryNumber(sc, "rmse_m"));
   }
   if (cov.x.empty()) return "";
   return "<h2>Against fixation count</h2><div class=plots>" +
@@ -249,7 +251,7 @@ std::vector<Series> FigureSeries(const std::vector<SweepRow>& rows, const std::s
   std::map<std::pair<std::string, std::string>, std::map<double, std::vector<double>>> groups;
   std::map<std::pair<std::string, std::string>, std::vector<double>> flat;
   for (const SweepRow& r : rows) {
-    const double v = Num(r.summary, key);
+    const double v = SummaryNumber(r.summary, key);
     if (!std::isfinite(v)) continue;
     const auto it = r.point.find(path);
     if (it != r.point.end())
@@ -328,7 +330,7 @@ std::string RunsTable(const nlohmann::json& grid, const std::vector<SweepRow>& r
            "</td>";
     }
     for (const auto& [key, label] : SweepFigures())
-      h += "<td>" + Fmt(Num(r.summary, key)) + "</td>";
+      h += "<td>" + Fmt(SummaryNumber(r.summary, key)) + "</td>";
     h += "</tr>\n";
   }
   return h + "</table>";
@@ -356,8 +358,9 @@ std::string SceneTable(const std::vector<SweepRow>& rows) {
       {"vs_static.fovea_median_abs_error_m", "common pixels: FOVEA median, mm"},
       {"vs_static.static_median_abs_error_m", "common pixels: static median, mm"}};
   auto value = [](const nlohmann::json& s, const std::string& key) {
-    if (key == "refused_share") return Num(s, "refused") / std::max(1.0, Num(s, "attempts"));
-    const double v = Num(s, key);
+    if (key == "refused_share")
+      return SummaryNumber(s, "refused") / std::max(1.0, SummaryNumber(s, "attempts"));
+    const double v = SummaryNumber(s, key);
     const bool metres = key.size() > 2 && key.compare(key.size() - 2, 2, "_m") == 0;
     return key == "median_rel_error" ? 100 * v : metres ? 1000 * v : v;
   };
@@ -413,17 +416,17 @@ struct CurvePoint {
 
 std::vector<CurvePoint> RunCurve(const std::string& run_dir, const nlohmann::json& summary) {
   std::vector<CurvePoint> c = {
-      {0, 0, Num(summary, "idr.coverage"), Num(summary, "idr.good_coverage")}};
+      {0, 0, SummaryNumber(summary, "idr.coverage"), SummaryNumber(summary, "idr.good_coverage")}};
   std::ifstream in(run_dir + "/" + run_folder::kRecords);
   int done = 0;
   double motion = 0;
   for (std::string line; std::getline(in, line);) {
     if (line.empty()) continue;
     const nlohmann::json r = nlohmann::json::parse(line);
-    motion += Num(r, "motion_time_s");
+    motion += SummaryNumber(r, "motion_time_s");
     if (r.value("ok", false)) ++done;
-    c.push_back(
-        {done, motion, Num(r.at("score"), "coverage"), Num(r.at("score"), "good_coverage")});
+    c.push_back({done, motion, SummaryNumber(r.at("score"), "coverage"),
+                 SummaryNumber(r.at("score"), "good_coverage")});
   }
   return c;
 }
@@ -542,37 +545,41 @@ std::string StrategySection(const std::string& dir, const std::vector<SweepRow>&
                              return Reached(c, level, by_motion, good);
                            }});
   columns.push_back({"final coverage", [](const SweepRow& r, const std::vector<CurvePoint>&) {
-                       return Num(r.summary, "coverage");
+                       return SummaryNumber(r.summary, "coverage");
                      }});
   columns.push_back({"final good coverage", [](const SweepRow& r, const std::vector<CurvePoint>&) {
-                       return Num(r.summary, "good_coverage");
+                       return SummaryNumber(r.summary, "good_coverage");
                      }});
   columns.push_back({"fixations done", [](const SweepRow& r, const std::vector<CurvePoint>&) {
-                       return Num(r.summary, "fixations");
+                       return SummaryNumber(r.summary, "fixations");
                      }});
   columns.push_back({"refused share", [](const SweepRow& r, const std::vector<CurvePoint>&) {
-                       return Num(r.summary, "refused") / std::max(1.0, Num(r.summary, "attempts"));
+                       return SummaryNumber(r.summary, "refused") /
+                              std::max(1.0, SummaryNumber(r.summary, "attempts"));
                      }});
   columns.push_back(
       {"motion s per fixation", [](const SweepRow& r, const std::vector<CurvePoint>&) {
-         return Num(r.summary, "travel.motion_time_s") / std::max(1.0, Num(r.summary, "fixations"));
+         return SummaryNumber(r.summary, "travel.motion_time_s") /
+                std::max(1.0, SummaryNumber(r.summary, "fixations"));
        }});
   columns.push_back({"pan deg per fixation", [](const SweepRow& r, const std::vector<CurvePoint>&) {
-                       return Num(r.summary, "travel.pan_deg") /
-                              std::max(1.0, Num(r.summary, "fixations"));
+                       return SummaryNumber(r.summary, "travel.pan_deg") /
+                              std::max(1.0, SummaryNumber(r.summary, "fixations"));
                      }});
   columns.push_back(
       {"tilt deg per fixation", [](const SweepRow& r, const std::vector<CurvePoint>&) {
-         return Num(r.summary, "travel.tilt_deg") / std::max(1.0, Num(r.summary, "fixations"));
+         return SummaryNumber(r.summary, "travel.tilt_deg") /
+                std::max(1.0, SummaryNumber(r.summary, "fixations"));
        }});
   columns.push_back(
       {"carriage mm per fixation", [](const SweepRow& r, const std::vector<CurvePoint>&) {
-         return 1e3 * Num(r.summary, "travel.carriage_m") /
-                std::max(1.0, Num(r.summary, "fixations"));
+         return 1e3 * SummaryNumber(r.summary, "travel.carriage_m") /
+                std::max(1.0, SummaryNumber(r.summary, "fixations"));
        }});
   columns.push_back(
       {"selection ms per fixation", [](const SweepRow& r, const std::vector<CurvePoint>&) {
-         return 1e3 * Num(r.summary, "time_s.select") / std::max(1.0, Num(r.summary, "fixations"));
+         return 1e3 * SummaryNumber(r.summary, "time_s.select") /
+                std::max(1.0, SummaryNumber(r.summary, "fixations"));
        }});
   std::string html =
       "<h2>Strategies</h2><p>Means over each strategy's runs (every scene and seed); for the "
@@ -636,8 +643,8 @@ std::string StrategySection(const std::string& dir, const std::vector<SweepRow>&
     std::map<std::string, std::array<std::vector<double>, 3>> per_scene;
     for (size_t i = 0; i < s.rows.size(); ++i) {
       auto& v = per_scene[s.rows[i]->scene];
-      v[0].push_back(Num(s.rows[i]->summary, "coverage"));
-      v[1].push_back(Num(s.rows[i]->summary, "good_coverage"));
+      v[0].push_back(SummaryNumber(s.rows[i]->summary, "coverage"));
+      v[1].push_back(SummaryNumber(s.rows[i]->summary, "good_coverage"));
       v[2].push_back(Reached(s.curves[i], 0.95, false, false));
     }
     std::array<std::vector<double>, 3> means, sds;

@@ -2,6 +2,7 @@
 // by gnuplot as inline SVG) for a run folder or a sweep folder.
 #pragma once
 
+#include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
 #include <vector>
@@ -26,6 +27,10 @@ std::string GnuplotSvg(const std::string& title, const std::string& xlabel,
 /// The same plot as a PNG picture at `path` (written whole or not at all).
 void GnuplotPng(const std::string& path, const std::string& title, const std::string& xlabel,
                 const std::string& ylabel, const std::vector<Series>& series, bool log_y = false);
+
+/// The number at a dotted path of a summary.json ("patch_3d_error.p90_m");
+/// NaN where the path is missing or its value is not a number (null).
+double SummaryNumber(const nlohmann::json& summary, const std::string& dotted);
 
 /// Writes DIR/report.html for a run folder (summary.json) or a sweep folder
 /// (grid.json and results.csv); returns its path. Throws UsageError when DIR
