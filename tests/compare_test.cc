@@ -67,6 +67,7 @@ TEST_CASE("compare pairs runs by scene and seed and reports the paired change", 
   CHECK(b.change == Approx(0).margin(1e-15));
   CHECK(b.up + b.down == 0);
   CHECK(FigureOf(c, "refused_share").base_mean == Approx(1.0 / 26));
+  CHECK(FigureOf(c, "wrong_share").base_mean == Approx(0.95 * 0.01));  // coverage x bad_share
   // Scenes in the base sweep's order, each over its paired seeds.
   REQUIRE(c.scenes.size() == 2);
   CHECK(c.scenes[0].scene == "two_planes");

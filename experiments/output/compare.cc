@@ -5,7 +5,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
-#include <tuple>
 #include <utility>
 
 #include "experiments/config/sweep.h"
@@ -26,17 +25,20 @@ std::string SceneName(const std::string& scene) {
   return fs::path(scene).stem().string();
 }
 
-// The figures compared pair by pair: summary keys, and refused_share
-// (refused over attempts, per run).
+// The figures compared pair by pair: summary keys, wrong_share (the mapped
+// pixels off by more than 1% as a share of the view's visible textured
+// pixels: coverage x bad_share) and refused_share (refused over attempts).
 const std::vector<std::string>& FigureKeys() {
   static const std::vector<std::string> kKeys = {
-      "good_coverage",    "coverage",         "bad_share", "edge_bad_share",
-      "mean_abs_error_m", "median_rel_error", "rmse_m",    "patch_3d_error.p90_m",
-      "refused_share",    "stale_idr_patches"};
+      "good_coverage",        "coverage",         "bad_share",        "wrong_share",
+      "edge_bad_share",       "mean_abs_error_m", "median_rel_error", "rmse_m",
+      "patch_3d_error.p90_m", "refused_share",    "stale_idr_patches"};
   return kKeys;
 }
 
 double Figure(const nlohmann::json& summary, const std::string& key) {
+  if (key == "wrong_share")
+    return SummaryNumber(summary, "coverage") * SummaryNumber(summary, "bad_share");
   if (key == "refused_share") {
     const double attempts = SummaryNumber(summary, "attempts");
     return attempts > 0 ? SummaryNumber(summary, "refused") / attempts : std::nan("");
