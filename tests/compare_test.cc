@@ -133,13 +133,22 @@ TEST_CASE("compare refuses an ambiguous pairing and a folder that is not a sweep
   CHECK_THROWS_WITH(experiments::SweepSummaries(dir.string()),
                     Catch::Contains("is not a sweep folder"));
   // A sweep folder's finished runs: scene names as the sweeps give them.
-  std::ofstream(dir / "grid.json") << R"({"runs": [{"id": "a"}, {"id": "b"}]})";
-  std::filesystem::create_directories(dir / "runs" / "a");
-  std::ofstream(dir / "runs" / "a" / "summary.json")
-      << R"({"scene": "/somewhere/scenes/two_planes.xml", "seed": 3, "method": "fovea"})";
+  // Runs are told apart by the grid's variant: a deterministic baseline's
+  // summary says method fovea too.
+  std::ofstream(dir / "grid.json") << R"({"runs": [{"id": "a", "variant": "fovea"},
+      {"id": "b", "variant": "fovea"}, {"id": "c", "variant": "deterministic"}]})";
+  for (const char* id : {"a", "c"}) {
+    std::filesystem::create_directories(dir / "runs" / id);
+    std::ofstream(dir / "runs" / id / "summary.json")
+        << R"({"scene": "/somewhere/scenes/two_planes.xml", "seed": 3, "method": "fovea"})";
+  }
   const std::vector<RunSummary> runs = experiments::SweepSummaries(dir.string());
-  REQUIRE(runs.size() == 1);  // "b" has no summary yet
+  REQUIRE(runs.size() == 2);  // "b" has no summary yet
   CHECK(runs[0].scene == "two_planes");
   CHECK(runs[0].seed == 3);
+  CHECK(runs[0].method == "fovea");
+  CHECK(runs[1].method == "deterministic");
+  CHECK(experiments::Compare(runs, runs, "fovea").pairs == 1);
+  CHECK(experiments::Compare(runs, runs, "deterministic").pairs == 1);
   std::filesystem::remove_all(dir);
 }

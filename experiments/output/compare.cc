@@ -132,8 +132,13 @@ std::vector<RunSummary> SweepSummaries(const std::string& dir) {
     const double seed = SummaryNumber(s, "seed");
     if (!s.contains("scene") || !s["scene"].is_string() || !std::isfinite(seed))
       throw std::runtime_error(path + ": no scene or seed");
-    runs.push_back({SceneName(s["scene"].get<std::string>()), s.value("method", "fovea"),
-                    static_cast<long long>(seed), s});
+    // The grid's variant, not the summary's method: a `deterministic`
+    // baseline's runs are method fovea too.
+    const std::string variant = run.contains("variant") && run["variant"].is_string()
+                                    ? run["variant"].get<std::string>()
+                                    : s.value("method", "fovea");
+    runs.push_back(
+        {SceneName(s["scene"].get<std::string>()), variant, static_cast<long long>(seed), s});
   }
   return runs;
 }

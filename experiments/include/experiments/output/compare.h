@@ -9,8 +9,8 @@
 namespace experiments {
 
 /// One finished run of a sweep: its scene (a catalog name, "random:N", or a
-/// scene file's stem), seed and method ("fovea" or a baseline), and its
-/// summary.json.
+/// scene file's stem), seed and method (the sweep's variant: "fovea", or a
+/// baseline, "deterministic" or "static_sgbm"), and its summary.json.
 struct RunSummary {
   std::string scene, method;
   long long seed = 0;
