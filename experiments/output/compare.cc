@@ -150,7 +150,6 @@ Comparison Compare(const std::vector<RunSummary>& base, const std::vector<RunSum
   std::vector<std::string> scene_order;
   const auto b = ByKey(base, method, "base", &scene_order);
   const auto v = ByKey(variant, method, "variant", nullptr);
-  std::vector<std::pair<const nlohmann::json*, const nlohmann::json*>> pairs;
   std::vector<std::string> pair_scenes;
   std::vector<const nlohmann::json*> base_side, variant_side;
   // Pairs in the base sweep's scene order, then by seed.
