@@ -185,7 +185,12 @@ TEST_CASE("local suppression: without it, fixations revisit mapped places more",
 TEST_CASE(
     "selection.reference_fallback: a choice of mapped (or foveal) data in the current view, or "
     "mapped data after a stalled fixation, gives way to a hole in the reference view",
-    "[ddr][slow]") {
+    "[ddr][slow][outcome]") {
+  // [outcome]: it compares the paths of six whole runs, about three
+  // minutes under the sanitizers, a tenth of CI's budget. The three rules
+  // share the fallback's code but for the condition that starts it
+  // (ChooseTarget in fovea/src/ddr.cc), and the sanitizer pass runs the
+  // other end-to-end tests at the default rule.
   // Each run's first fallback comes at its second attempt, where the
   // default's choice is mapped data (random:4 seed 0) and foveal data
   // (random:7 seed 0), in the release and the sanitizer builds alike
