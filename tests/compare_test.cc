@@ -135,8 +135,11 @@ TEST_CASE("compare refuses an ambiguous pairing and a folder that is not a sweep
   // A sweep folder's finished runs: scene names as the sweeps give them.
   // Runs are told apart by the grid's variant: a deterministic baseline's
   // summary says method fovea too.
-  std::ofstream(dir / "grid.json") << R"({"runs": [{"id": "a", "variant": "fovea"},
-      {"id": "b", "variant": "fovea"}, {"id": "c", "variant": "deterministic"}]})";
+  std::ofstream(dir / "grid.json") << R"({"runs": [
+      {"id": "a", "variant": "fovea", "point": {"seed": "3"}, "config": [["scene", "two_planes"]]},
+      {"id": "b", "variant": "fovea", "point": {"seed": "4"}, "config": [["scene", "two_planes"]]},
+      {"id": "c", "variant": "deterministic", "point": {"seed": "3"},
+       "config": [["scene", "two_planes"]]}]})";
   for (const char* id : {"a", "c"}) {
     std::filesystem::create_directories(dir / "runs" / id);
     std::ofstream(dir / "runs" / id / "summary.json")

@@ -122,23 +122,18 @@ bool IsDdrCatalogScene(const std::string& scene) {
 std::vector<RunSummary> SweepSummaries(const std::string& dir) {
   if (!fs::is_regular_file(dir + "/grid.json"))
     throw UsageError("'" + rig::ClipForMessage(dir) + "' is not a sweep folder (no grid.json)");
-  const nlohmann::json grid = ReadJson(dir + "/grid.json");
+  int missing = 0;
   std::vector<RunSummary> runs;
-  for (const auto& run : grid.at("runs")) {
-    const std::string path =
-        dir + "/runs/" + run.at("id").get<std::string>() + "/" + run_folder::kSummary;
-    if (!fs::exists(path)) continue;
-    const nlohmann::json s = ReadJson(path);
+  for (SweepRow& row : SweepRows(dir, ReadJson(dir + "/grid.json"), &missing)) {
+    const nlohmann::json& s = row.summary;
     const double seed = SummaryNumber(s, "seed");
     if (!s.contains("scene") || !s["scene"].is_string() || !std::isfinite(seed))
-      throw std::runtime_error(path + ": no scene or seed");
+      throw std::runtime_error(dir + "/runs/" + row.id + "/" + run_folder::kSummary +
+                               ": no scene or seed");
     // The grid's variant, not the summary's method: a `deterministic`
     // baseline's runs are method fovea too.
-    const std::string variant = run.contains("variant") && run["variant"].is_string()
-                                    ? run["variant"].get<std::string>()
-                                    : s.value("method", "fovea");
-    runs.push_back(
-        {SceneName(s["scene"].get<std::string>()), variant, static_cast<long long>(seed), s});
+    runs.push_back({SceneName(s["scene"].get<std::string>()), row.variant,
+                    static_cast<long long>(seed), std::move(row.summary)});
   }
   return runs;
 }

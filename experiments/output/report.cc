@@ -201,12 +201,7 @@ std::string RunReport(const std::string& dir) {
   return h + "</body></html>\n";
 }
 
-// One finished run of a sweep, for the report.
-struct SweepRow {
-  std::string id, variant, scene;
-  std::map<std::string, std::string> point;
-  nlohmann::json summary;
-};
+}  // namespace
 
 std::vector<SweepRow> SweepRows(const std::string& dir, const nlohmann::json& grid, int* missing) {
   std::vector<SweepRow> rows;
@@ -226,6 +221,8 @@ std::vector<SweepRow> SweepRows(const std::string& dir, const nlohmann::json& gr
   }
   return rows;
 }
+
+namespace {
 
 // The figures a sweep report plots and tabulates.
 const std::vector<std::pair<std::string, std::string>>& SweepFigures() {
