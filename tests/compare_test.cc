@@ -145,13 +145,25 @@ TEST_CASE("compare refuses an ambiguous pairing and a folder that is not a sweep
     std::ofstream(dir / "runs" / id / "summary.json")
         << R"({"scene": "/somewhere/scenes/two_planes.xml", "seed": 3, "method": "fovea"})";
   }
-  const std::vector<RunSummary> runs = experiments::SweepSummaries(dir.string());
+  int unfinished = -1;
+  const std::vector<RunSummary> runs = experiments::SweepSummaries(dir.string(), &unfinished);
   REQUIRE(runs.size() == 2);  // "b" has no summary yet
+  CHECK(unfinished == 1);
   CHECK(runs[0].scene == "two_planes");
   CHECK(runs[0].seed == 3);
   CHECK(runs[0].method == "fovea");
   CHECK(runs[1].method == "deterministic");
   CHECK(experiments::Compare(runs, runs, "fovea").pairs == 1);
   CHECK(experiments::Compare(runs, runs, "deterministic").pairs == 1);
+  // The text names the unfinished runs only when there are any; the JSON
+  // always carries both counts.
+  experiments::Comparison c = experiments::Compare(runs, runs, "fovea");
+  CHECK_THAT(experiments::ComparisonText(c), !Catch::Contains("not finished"));
+  c.variant_unfinished = unfinished;
+  CHECK_THAT(experiments::ComparisonText(c),
+             Catch::Contains("runs not finished (no summary.json), left out: 0 in base, 1 in "
+                             "variant"));
+  CHECK(experiments::ComparisonJson(c)["base_unfinished"] == 0);
+  CHECK(experiments::ComparisonJson(c)["variant_unfinished"] == 1);
   std::filesystem::remove_all(dir);
 }

@@ -450,7 +450,11 @@ void AddSweepCommands(CLI::App& app, std::function<int()>* run) {
   cmp->callback([cmp_args, run] {
     *run = [cmp_args] {
       const CompareArgs& a = *cmp_args;
-      const Comparison c = Compare(SweepSummaries(a.base), SweepSummaries(a.variant), a.method);
+      int base_unfinished = 0, variant_unfinished = 0;
+      Comparison c = Compare(SweepSummaries(a.base, &base_unfinished),
+                             SweepSummaries(a.variant, &variant_unfinished), a.method);
+      c.base_unfinished = base_unfinished;
+      c.variant_unfinished = variant_unfinished;
       if (c.pairs == 0)
         throw UsageError("no " + rig::ClipForMessage(a.method) +
                          " runs pair up by scene and seed between '" + rig::ClipForMessage(a.base) +

@@ -119,7 +119,7 @@ bool IsDdrCatalogScene(const std::string& scene) {
   return scene == "cylinder_planes" || scene == "two_planes" || scene == "three_surfaces";
 }
 
-std::vector<RunSummary> SweepSummaries(const std::string& dir) {
+std::vector<RunSummary> SweepSummaries(const std::string& dir, int* unfinished) {
   if (!fs::is_regular_file(dir + "/grid.json"))
     throw UsageError("'" + rig::ClipForMessage(dir) + "' is not a sweep folder (no grid.json)");
   int missing = 0;
@@ -135,6 +135,7 @@ std::vector<RunSummary> SweepSummaries(const std::string& dir) {
     runs.push_back({SceneName(s["scene"].get<std::string>()), row.variant,
                     static_cast<long long>(seed), std::move(row.summary)});
   }
+  if (unfinished) *unfinished = missing;
   return runs;
 }
 
@@ -209,9 +210,16 @@ std::string ComparisonText(const Comparison& c) {
   std::string t;
   char line[256];
   std::snprintf(line, sizeof line,
-                "%d pair%s of %s runs by scene and seed (unpaired: %d in base, %d in variant)\n\n",
+                "%d pair%s of %s runs by scene and seed (unpaired: %d in base, %d in variant)\n",
                 c.pairs, c.pairs == 1 ? "" : "s", c.method.c_str(), c.base_only, c.variant_only);
   t += line;
+  if (c.base_unfinished > 0 || c.variant_unfinished > 0) {
+    std::snprintf(line, sizeof line,
+                  "runs not finished (no summary.json), left out: %d in base, %d in variant\n",
+                  c.base_unfinished, c.variant_unfinished);
+    t += line;
+  }
+  t += "\n";
   std::snprintf(line, sizeof line, "%-22s %10s %10s %10s %8s %5s %9s\n", "figure (mean)", "base",
                 "variant", "change", "se", "pairs", "up / down");
   t += line;
@@ -280,6 +288,8 @@ nlohmann::json ComparisonJson(const Comparison& c) {
           {"pairs", c.pairs},
           {"base_only", c.base_only},
           {"variant_only", c.variant_only},
+          {"base_unfinished", c.base_unfinished},
+          {"variant_unfinished", c.variant_unfinished},
           {"figures", figures},
           {"lines", {{"base", LinesJson(c.base)}, {"variant", LinesJson(c.variant)}}},
           {"scenes", scenes}};

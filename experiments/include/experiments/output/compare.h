@@ -18,9 +18,9 @@ struct RunSummary {
 };
 
 /// The finished runs of sweep folder `dir` (its grid.json; runs without a
-/// summary.json are left out). Throws UsageError when `dir` is not a sweep
-/// folder.
-std::vector<RunSummary> SweepSummaries(const std::string& dir);
+/// summary.json are left out, and counted in `unfinished` if given). Throws
+/// UsageError when `dir` is not a sweep folder.
+std::vector<RunSummary> SweepSummaries(const std::string& dir, int* unfinished = nullptr);
 
 /// The scenes whose coverage issue 19 holds to the catalog's line: the
 /// three DDR catalog scenes.
@@ -61,6 +61,9 @@ struct Comparison {
   std::string method;
   int pairs = 0;
   int base_only = 0, variant_only = 0;  ///< runs of `method` with no partner
+  /// Runs of either sweep's grid without a summary.json (not finished: any
+  /// method), set by the caller from SweepSummaries; the text names them.
+  int base_unfinished = 0, variant_unfinished = 0;
   std::vector<PairedFigure> figures;
   SetLines base, variant;
   std::vector<ScenePair> scenes;  ///< in the base sweep's order
