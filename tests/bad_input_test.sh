@@ -237,6 +237,16 @@ expect 2 "no static_sgbm runs pair up" compare "$work/held" "$work/held" --metho
 out=$("$fovea" compare "$work/held" "$work/held" 2>&1)
 [[ $out == *"1 pair of fovea runs by scene and seed"* && $out == *"good_coverage"* ]] ||
   fail "compare of a sweep with itself: ${out:0:300}"
+# A sweep folder whose grid.json names a run by a path out of its runs/
+# folder (edited by hand, or not fovea's): every reader refuses it (exit 1)
+# before writing anything, and collect leaves no DIR behind.
+rm -rf "$work/tampered" && cp -r "$work/held" "$work/tampered"
+sed -i '0,/"id": "[^"]*"/s//"id": "..\/..\/escape"/' "$work/tampered/grid.json"
+grep -q '"id": "../../escape"' "$work/tampered/grid.json" || fail "could not tamper with the grid"
+expect 1 "is not a sweep grid: runs[0].id" compare "$work/tampered" "$work/held"
+expect 1 "is not a sweep grid: runs[0].id" report "$work/tampered"
+expect 1 "is not a sweep grid: runs[0].id" collect "$t/merged" "$work/tampered"
+[ ! -e "$work/tampered/report.html" ] && [ ! -e "$work/escape" ] || fail "a tampered grid was written from"
 
 # ---- good inputs that used to fail -------------------------------------------
 # [2] a trailing slash names the folder

@@ -135,7 +135,8 @@ TEST_CASE("compare refuses an ambiguous pairing and a folder that is not a sweep
   // A sweep folder's finished runs: scene names as the sweeps give them.
   // Runs are told apart by the grid's variant: a deterministic baseline's
   // summary says method fovea too.
-  std::ofstream(dir / "grid.json") << R"({"runs": [
+  std::ofstream(dir / "grid.json") << R"({"axes": [{"path": "seed", "values": ["3", "4"]}],
+      "baselines": ["deterministic"], "runs": [
       {"id": "a", "variant": "fovea", "point": {"seed": "3"}, "config": [["scene", "two_planes"]]},
       {"id": "b", "variant": "fovea", "point": {"seed": "4"}, "config": [["scene", "two_planes"]]},
       {"id": "c", "variant": "deterministic", "point": {"seed": "3"},

@@ -347,6 +347,8 @@ int Collect(const std::string& dir_arg, const std::vector<std::string>& shards, 
     if (ReadFile(s + "/grid.json") != ReadFile(shards[0] + "/grid.json"))
       throw UsageError("'" + rig::ClipForMessage(s) + "' holds a different sweep than '" +
                        rig::ClipForMessage(shards[0]) + "' (grid.json differs)");
+  // The grid is checked before anything is written.
+  if (!shards.empty()) ReadGridJson(shards[0]);
   if (!fs::exists(dir + "/grid.json")) {
     if (shards.empty())
       throw UsageError("'" + rig::ClipForMessage(dir) + "' is not a sweep folder (no grid.json)");
@@ -360,7 +362,7 @@ int Collect(const std::string& dir_arg, const std::vector<std::string>& shards, 
       WriteTextAtomic(dir + "/sweep.yaml", ReadFile(shards[0] + "/sweep.yaml"));
   }
   const std::string grid_text = ReadFile(dir + "/grid.json");
-  const nlohmann::json grid = ReadJson(dir + "/grid.json");
+  const nlohmann::json grid = ReadGridJson(dir);
   EnsureDirectory(dir + "/runs");
   int copied = 0;
   for (const std::string& s : shards) {

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "experiments/usage_error.h"
+#include "rig/input_file.h"
 #include "scenes/catalog.h"
 
 namespace experiments {
@@ -324,6 +325,58 @@ nlohmann::json ReadJson(const std::string& path) {
   } catch (const nlohmann::json::exception& e) {
     throw std::runtime_error("'" + path + "' is not valid JSON: " + e.what());
   }
+}
+
+nlohmann::json ReadGridJson(const std::string& dir) {
+  const std::string path = dir + "/grid.json";
+  const nlohmann::json grid = ReadJson(path);
+  auto fail = [&](const std::string& where, const std::string& what) {
+    throw std::runtime_error("'" + rig::ClipForMessage(path) + "' is not a sweep grid: " + where +
+                             ": " + what);
+  };
+  auto strings = [&](const nlohmann::json& j, const std::string& where) {
+    if (!j.is_array()) fail(where, "expected a list");
+    for (size_t i = 0; i < j.size(); ++i)
+      if (!j[i].is_string()) fail(where + "[" + std::to_string(i) + "]", "expected a string");
+  };
+  auto field = [&](const nlohmann::json& j, const char* key, const std::string& where) {
+    if (!j.is_object() || !j.contains(key)) fail(where, std::string("no '") + key + "'");
+    return j[key];
+  };
+  if (!grid.is_object()) fail("the file", "expected an object");
+  const nlohmann::json axes = field(grid, "axes", "the file");
+  if (!axes.is_array()) fail("axes", "expected a list");
+  for (size_t i = 0; i < axes.size(); ++i) {
+    const std::string where = "axes[" + std::to_string(i) + "]";
+    if (!field(axes[i], "path", where).is_string()) fail(where + ".path", "expected a string");
+    strings(field(axes[i], "values", where), where + ".values");
+  }
+  strings(field(grid, "baselines", "the file"), "baselines");
+  const nlohmann::json runs = field(grid, "runs", "the file");
+  if (!runs.is_array() || runs.empty()) fail("runs", "expected a list of at least one run");
+  for (size_t i = 0; i < runs.size(); ++i) {
+    const std::string where = "runs[" + std::to_string(i) + "]";
+    const nlohmann::json id = field(runs[i], "id", where);
+    // A folder name inside DIR/runs, never a path out of it.
+    if (!id.is_string() || id.get<std::string>().empty() ||
+        id.get<std::string>().find_first_not_of(
+            "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+            "0123456789_-") != std::string::npos)
+      fail(where + ".id", "expected a name of letters, digits, '_' and '-'");
+    if (!field(runs[i], "variant", where).is_string())
+      fail(where + ".variant", "expected a string");
+    const nlohmann::json point = field(runs[i], "point", where);
+    if (!point.is_object()) fail(where + ".point", "expected an object");
+    for (auto it = point.begin(); it != point.end(); ++it)
+      if (!it.value().is_string()) fail(where + ".point." + it.key(), "expected a string");
+    const nlohmann::json config = field(runs[i], "config", where);
+    if (!config.is_array()) fail(where + ".config", "expected a list");
+    for (size_t k = 0; k < config.size(); ++k)
+      if (!config[k].is_array() || config[k].size() != 2 || !config[k][0].is_string() ||
+          !config[k][1].is_string())
+        fail(where + ".config[" + std::to_string(k) + "]", "expected [parameter, value]");
+  }
+  return grid;
 }
 
 std::string ResultsCsv(const std::string& dir, const nlohmann::json& grid,

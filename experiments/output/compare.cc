@@ -124,7 +124,7 @@ std::vector<RunSummary> SweepSummaries(const std::string& dir, int* unfinished) 
     throw UsageError("'" + rig::ClipForMessage(dir) + "' is not a sweep folder (no grid.json)");
   int missing = 0;
   std::vector<RunSummary> runs;
-  for (SweepRow& row : SweepRows(dir, ReadJson(dir + "/grid.json"), &missing)) {
+  for (SweepRow& row : SweepRows(dir, ReadGridJson(dir), &missing)) {
     const nlohmann::json& s = row.summary;
     const double seed = SummaryNumber(s, "seed");
     if (!s.contains("scene") || !s["scene"].is_string() || !std::isfinite(seed))

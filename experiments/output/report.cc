@@ -668,7 +668,7 @@ std::string StrategySection(const std::string& dir, const std::vector<SweepRow>&
 }
 
 std::string SweepReport(const std::string& dir) {
-  const nlohmann::json grid = ReadJson(dir + "/grid.json");
+  const nlohmann::json grid = ReadGridJson(dir);
   int missing = 0;
   const std::vector<SweepRow> rows = SweepRows(dir, grid, &missing);
   std::string h =

@@ -67,4 +67,11 @@ std::pair<int, int> ParseShard(const std::string& text);
 /// Reads a whole JSON file; throws std::runtime_error naming it.
 nlohmann::json ReadJson(const std::string& path);
 
+/// Reads DIR/grid.json and checks that it has the shape GridJson writes
+/// (axes, baselines, at least one run, each with an id that names a folder
+/// inside DIR/runs, a variant, a point and its parameters), so that what
+/// reads it meets no surprise; throws std::runtime_error naming the file and
+/// the first thing wrong.
+nlohmann::json ReadGridJson(const std::string& dir);
+
 }  // namespace experiments
