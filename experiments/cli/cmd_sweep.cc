@@ -347,11 +347,14 @@ int Collect(const std::string& dir_arg, const std::vector<std::string>& shards, 
     if (ReadFile(s + "/grid.json") != ReadFile(shards[0] + "/grid.json"))
       throw UsageError("'" + rig::ClipForMessage(s) + "' holds a different sweep than '" +
                        rig::ClipForMessage(shards[0]) + "' (grid.json differs)");
-  // The grid is checked before anything is written.
-  if (!shards.empty()) ReadGridJson(shards[0]);
-  if (!fs::exists(dir + "/grid.json")) {
-    if (shards.empty())
-      throw UsageError("'" + rig::ClipForMessage(dir) + "' is not a sweep folder (no grid.json)");
+  const bool fresh = !fs::exists(dir + "/grid.json");
+  if (fresh && shards.empty())
+    throw UsageError("'" + rig::ClipForMessage(dir) + "' is not a sweep folder (no grid.json)");
+  // The grid, read and checked before anything is written: the shards'
+  // (one text, checked above) where DIR has none yet, else DIR's own (each
+  // shard's text is compared with it below).
+  const nlohmann::json grid = ReadGridJson(fresh ? shards[0] : dir);
+  if (fresh) {
     // Merging into a new or empty folder only, or one that holds nothing but
     // the shards being merged (sweep.sbatch writes them as DIR/shard-I):
     // never into one that holds something else.
@@ -362,7 +365,6 @@ int Collect(const std::string& dir_arg, const std::vector<std::string>& shards, 
       WriteTextAtomic(dir + "/sweep.yaml", ReadFile(shards[0] + "/sweep.yaml"));
   }
   const std::string grid_text = ReadFile(dir + "/grid.json");
-  const nlohmann::json grid = ReadGridJson(dir);
   EnsureDirectory(dir + "/runs");
   int copied = 0;
   for (const std::string& s : shards) {

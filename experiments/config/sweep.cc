@@ -339,12 +339,13 @@ nlohmann::json ReadGridJson(const std::string& dir) {
     for (size_t i = 0; i < j.size(); ++i)
       if (!j[i].is_string()) fail(where + "[" + std::to_string(i) + "]", "expected a string");
   };
-  auto field = [&](const nlohmann::json& j, const char* key, const std::string& where) {
+  auto field = [&](const nlohmann::json& j, const char* key,
+                   const std::string& where) -> const nlohmann::json& {
     if (!j.is_object() || !j.contains(key)) fail(where, std::string("no '") + key + "'");
-    return j[key];
+    return j.at(key);
   };
   if (!grid.is_object()) fail("the file", "expected an object");
-  const nlohmann::json axes = field(grid, "axes", "the file");
+  const nlohmann::json& axes = field(grid, "axes", "the file");
   if (!axes.is_array()) fail("axes", "expected a list");
   for (size_t i = 0; i < axes.size(); ++i) {
     const std::string where = "axes[" + std::to_string(i) + "]";
@@ -352,11 +353,11 @@ nlohmann::json ReadGridJson(const std::string& dir) {
     strings(field(axes[i], "values", where), where + ".values");
   }
   strings(field(grid, "baselines", "the file"), "baselines");
-  const nlohmann::json runs = field(grid, "runs", "the file");
+  const nlohmann::json& runs = field(grid, "runs", "the file");
   if (!runs.is_array() || runs.empty()) fail("runs", "expected a list of at least one run");
   for (size_t i = 0; i < runs.size(); ++i) {
     const std::string where = "runs[" + std::to_string(i) + "]";
-    const nlohmann::json id = field(runs[i], "id", where);
+    const nlohmann::json& id = field(runs[i], "id", where);
     // A folder name inside DIR/runs, never a path out of it.
     if (!id.is_string() || id.get<std::string>().empty() ||
         id.get<std::string>().find_first_not_of(
@@ -365,11 +366,11 @@ nlohmann::json ReadGridJson(const std::string& dir) {
       fail(where + ".id", "expected a name of letters, digits, '_' and '-'");
     if (!field(runs[i], "variant", where).is_string())
       fail(where + ".variant", "expected a string");
-    const nlohmann::json point = field(runs[i], "point", where);
+    const nlohmann::json& point = field(runs[i], "point", where);
     if (!point.is_object()) fail(where + ".point", "expected an object");
     for (auto it = point.begin(); it != point.end(); ++it)
       if (!it.value().is_string()) fail(where + ".point." + it.key(), "expected a string");
-    const nlohmann::json config = field(runs[i], "config", where);
+    const nlohmann::json& config = field(runs[i], "config", where);
     if (!config.is_array()) fail(where + ".config", "expected a list");
     for (size_t k = 0; k < config.size(); ++k)
       if (!config[k].is_array() || config[k].size() != 2 || !config[k][0].is_string() ||
