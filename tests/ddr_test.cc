@@ -201,7 +201,10 @@ TEST_CASE(
   // came at the fourth before, has none in its first twelve now); eight
   // leave room for another path in the sanitizer build. The cases were
   // found with the two-camera placements tried first
-  // (foveal.left_pair_first=false), whose paths reach them.
+  // (foveal.left_pair_first=false), whose paths reach them, and with the
+  // defaults before 2026-12-08 (foveal.baseline_m 0.06, patches fused
+  // within a level only), which the runs keep: the narrower baseline and
+  // the fusion across levels move every path.
   struct Case {
     std::string scene, seed, fallback, fixations;
   };
@@ -211,7 +214,8 @@ TEST_CASE(
     INFO(scene << " seed " << seed << ", " << fallback);
     const fs::path with = Out("fallback"), without = Out("nofallback");
     const std::string run = "--scene " + scene + " --seed " + seed + " --fixations " + fixations +
-                            " --set foveal.left_pair_first=false";
+                            " --set foveal.left_pair_first=false --set foveal.baseline_m=0.06"
+                            " --set integration.fuse_across_levels=false";
     RunFovea(run + " --set selection.reference_fallback=" + fallback, with);
     RunFovea(run + " --set selection.reference_fallback=none", without);
     const auto rw = Records(with), rn = Records(without);
@@ -274,11 +278,14 @@ TEST_CASE(
   // the check where such a strip arises. The selection passes over the
   // marked patches (loop.stay_in_idr_view), so the check can change the
   // path; on this run no choice fell on one (measured), and only the
-  // reference view's map differs.
+  // reference view's map differs. The path is the one of the defaults
+  // before 2026-12-08 too (foveal.baseline_m 0.06, patches fused within a
+  // level only): the narrower baseline and the fusion across levels move it.
   const fs::path on = Out("seen_on"), off = Out("seen_off");
   const std::string args =
       "--scene two_planes --seed 2 --fixations 12 --set foveal.edge_hole_px=7 "
-      "--set foveal.horizontal_disparity_limit_px=32";
+      "--set foveal.horizontal_disparity_limit_px=32 --set foveal.baseline_m=0.06 "
+      "--set integration.fuse_across_levels=false";
   RunFovea(args + " --set integration.reference_min_ncc=0.5", on);
   RunFovea(args + " --set integration.reference_min_ncc=0", off);
   const std::vector<json> a = Records(on), b = Records(off);

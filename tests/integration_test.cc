@@ -163,6 +163,46 @@ TEST_CASE("fusing two noisy observations of a plane divides the error by sqrt 2"
   CHECK(fovea::Integrate(&map, NoisyGrid(12, 0.3, 1.0, sigma, &rng), view, paper).fused == 0);
 }
 
+TEST_CASE("a foveal patch is fused with the peripheral patch under it, weighed by their sigmas",
+          "[fovea][integration]") {
+  // The plane y = 1 seen by the periphery (20 cm patches, 1 mm too far,
+  // sigma 2 mm) and then by a fovea (5 cm patches, 3 mm too near, sigma 6
+  // mm): the inverse-variance mean is 0.6 mm too far, with sigma
+  // 1 / sqrt(1 / 2^2 + 1 / 6^2) mm.
+  const rig::CameraView view = View();
+  auto shifted = [](fovea::PatchMap grid, double dy, double sigma) {
+    fovea::PatchMap out;
+    for (fovea::Patch p : grid.patches()) {
+      for (auto& c : p.corners_W) c.y() += dy;
+      p.sigma_z_m = sigma;
+      out.Add(p);
+    }
+    return out;
+  };
+  const fovea::PatchMap periphery =
+      shifted(Grid(3, 0.3, 1.0, fovea::PatchLevel::kPeripheral, 1), 0.001, 0.002);
+  const fovea::PatchMap fovea_patches =
+      shifted(Grid(12, 0.3, 1.0, fovea::PatchLevel::kFoveal), -0.003, 0.006);
+  fovea::PatchMap map = periphery;
+  const auto stats = fovea::Integrate(&map, fovea_patches, view);
+  CHECK(stats.fused == 144);
+  CHECK(stats.replaced[1] == 9);  // the foveal patches, fused, replace the peripheral ones
+  CHECK(RmsError(map, view, 1.0, 60) == Approx(0.0006).epsilon(0.02));
+  const double fused_sigma = 1 / std::sqrt(1 / (0.002 * 0.002) + 1 / (0.006 * 0.006));
+  for (const fovea::Patch& p : map.patches()) CHECK(p.sigma_z_m == Approx(fused_sigma));
+  // The paper's hierarchy alone: the finer level replaces the coarser one
+  // as it is, 3 mm off.
+  fovea::IntegrationOptions hierarchy;
+  hierarchy.fuse_across_levels = false;
+  map = periphery;
+  CHECK(fovea::Integrate(&map, fovea_patches, view, hierarchy).fused == 0);
+  CHECK(RmsError(map, view, 1.0, 60) == Approx(0.003).epsilon(0.02));
+  // IDR's coarse guesses are never fused into finer patches.
+  map = shifted(Grid(3, 0.3, 1.0, fovea::PatchLevel::kIdr), 0.001, 0.002);
+  CHECK(fovea::Integrate(&map, fovea_patches, view).fused == 0);
+  CHECK(RmsError(map, view, 1.0, 60) == Approx(0.003).epsilon(0.02));
+}
+
 TEST_CASE("a coarse patch that certain data contradicts goes, whichever came first",
           "[fovea][integration]") {
   const rig::CameraView view = View();

@@ -193,6 +193,10 @@ TEST_CASE(
   fovea::FixationOptions o = fovea::ResolvedFixationOptions({});  // the run's
   o.choose_placement = false;  // the symmetric carriages OnLeftAxis assumes
   o.mapped_baseline_m = 0;     // and its baseline, though the map holds the point
+  // The false match was found at 0.06 m (the default until 2026-12-08); at
+  // 0.04 m the servo settles nearer than idr.z_min_m, refused before the
+  // map check.
+  o.baseline_m = 0.06;
   const Eigen::Vector3d air = OnLeftAxis(rig, {-0.1, 1.0, 0.0}, 0.4, o.baseline_m);
   o.map_check = false;
   const fovea::FixationResult trusting = fovea::Fixate(rig, idr.map, air, matcher, o);

@@ -365,6 +365,7 @@ void AddDdrParams(RunConfig* c, std::vector<ConfigParam>* params) {
           {&fp::kIntegrationOverlapShare, &f.integration.overlap_share},
           {&fp::kIntegrationContradictionShare, &f.integration.contradiction_share},
           {&fp::kIntegrationFuse, &f.integration.fuse},
+          {&fp::kIntegrationFuseAcrossLevels, &f.integration.fuse_across_levels},
           {&fp::kIntegrationRetireIdr, &f.integration.retire_idr},
           {&fp::kIntegrationRetireIdrShare, &f.integration.retire_idr_share},
           {&fp::kIntegrationRetireInFixationView, &f.integration.retire_in_fixation_view},

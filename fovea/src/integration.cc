@@ -37,10 +37,12 @@ bool Yields(const Patch& a, double za, const Patch& b, double zb, bool a_is_old)
 
 // Moves each corner of `fresh` along its viewing ray to the inverse-variance
 // mean of its depth and the old map's where the old map shows the same
-// surface there at the same or a finer level (the old patch seen just inside
-// the corner, its plane met by the corner's ray); the patch's sigma shrinks
-// accordingly. Returns whether any corner was fused.
-bool Fuse(const PatchMap& map, const cv::Mat& old_ids, const rig::CameraView& view, Patch* fresh) {
+// surface there at the same or a finer level, or with `across_levels` at any
+// foveal or peripheral level (the old patch seen just inside the corner, its
+// plane met by the corner's ray); the patch's sigma shrinks accordingly.
+// Returns whether any corner was fused.
+bool Fuse(const PatchMap& map, const cv::Mat& old_ids, const rig::CameraView& view,
+          bool across_levels, Patch* fresh) {
   const Eigen::Isometry3d camera_T_world = view.world_T_camera.inverse();
   const Eigen::Vector3d origin = view.world_T_camera.translation();
   const rig::CameraIntrinsics& k = view.intrinsics;
@@ -62,7 +64,9 @@ bool Fuse(const PatchMap& map, const cv::Mat& old_ids, const rig::CameraView& vi
     const double t_old = (old.Centre() - origin).dot(n) / denom, t_new = (corner - origin).norm();
     const double along =
         ray.dot(view.world_T_camera.linear().col(2));  // planar depth per unit range
-    if (old.Fineness() < fresh->Fineness() || !(old.sigma_z_m > 0) || !(fresh->sigma_z_m > 0) ||
+    const bool coarser = old.Fineness() < fresh->Fineness();
+    if ((coarser && (!across_levels || old.level == PatchLevel::kIdr)) || !(old.sigma_z_m > 0) ||
+        !(fresh->sigma_z_m > 0) ||
         !PatchMap::SameSurface(t_new * along, *fresh, t_old * along, old))
       continue;
     const double wn = 1 / (fresh->sigma_z_m * fresh->sigma_z_m),
@@ -136,11 +140,11 @@ double InViewShare(const Patch& p, const rig::CameraView& view) {
 
 // The new patches, each fused with the map's patches of the same surface.
 PatchMap FuseAll(const PatchMap& map, const cv::Mat& old_ids, const rig::CameraView& view,
-                 const PatchMap& fresh, int* fused) {
+                 const PatchMap& fresh, bool across_levels, int* fused) {
   PatchMap out;
   for (const Patch& p : fresh.patches()) {
     Patch q = p;
-    *fused += Fuse(map, old_ids, view, &q);
+    *fused += Fuse(map, old_ids, view, across_levels, &q);
     out.Add(q);
   }
   return out;
@@ -178,8 +182,9 @@ IntegrationStats Integrate(PatchMap* map, const PatchMap& fresh_in, const rig::C
   stats.offered = static_cast<int>(fresh_in.size());
   cv::Mat old_depth, old_ids, new_depth, new_ids;
   map->Render(view.world_T_camera, view.intrinsics, &old_depth, &old_ids);
-  const PatchMap fresh =
-      options.fuse ? FuseAll(*map, old_ids, view, fresh_in, &stats.fused) : fresh_in;
+  const PatchMap fresh = options.fuse ? FuseAll(*map, old_ids, view, fresh_in,
+                                                options.fuse_across_levels, &stats.fused)
+                                      : fresh_in;
   fresh.Render(view.world_T_camera, view.intrinsics, &new_depth, &new_ids);
   const size_t n_old = map->size(), n_new = fresh.size();
 

@@ -98,7 +98,7 @@ struct IdrOptions {
   double min_expansion = 1.1;    ///< below this, expanding is not worth a stage
   double vergent_search_px = 4;  ///< P: the vergent stage searches +-P px
   /// Baseline of the vergent stage, for the termination rule. Deliberately
-  /// not tied to foveal.baseline_m (0.06): with 0.06 IDR stops at a 0.012 m
+  /// not tied to foveal.baseline_m (0.04): with 0.06 IDR stops at a 0.012 m
   /// baseline instead of 0.048 m, and the coarser map cost fovea run
   /// coverage (two_planes 0.995 -> 0.949, three_surfaces 0.947 -> 0.927,
   /// seed 0) and two_planes' near-then-far order.

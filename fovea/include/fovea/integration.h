@@ -27,6 +27,17 @@ struct IntegrationOptions {
   /// mean along the viewing ray) with the map's depth there where the map
   /// shows the same surface at the same or a finer level.
   bool fuse = true;
+  /// Beyond the paper, with fuse: a new foveal or peripheral patch is fused
+  /// with the map's foveal and peripheral patches of its surface whatever
+  /// their levels, each weighed by its sigma; false: only with patches of
+  /// its level or finer. IDR patches are never fused into finer ones. The
+  /// paper's hierarchy has a finer level outrank a coarser one, but the
+  /// periphery is matched at full resolution too
+  /// (FovealOptions::rectified_periphery_full_resolution), over blocks four
+  /// times the fovea's: over the accuracy benchmark, fusing them took the
+  /// median relative error down on every one of its 42 runs (README, "The
+  /// map's trust").
+  bool fuse_across_levels = true;
   /// Beyond the paper: after each fixation, IDR patches whose footprint in
   /// the IDR view, or in the fixation's own view, finer patches (of any
   /// fixations) cover by retire_idr_share are removed (CoveredIdrPatches).

@@ -444,6 +444,12 @@ inline constexpr ParamSpec kIntegrationFuse{
     "beyond the paper: fuse a new patch with the map's depth where the map shows the same surface "
     "at the same or a "
     "finer level (inverse-variance mean; false: the paper's replacement only)"};
+inline constexpr ParamSpec kIntegrationFuseAcrossLevels{
+    "integration.fuse_across_levels",
+    "beyond the paper: with integration.fuse, a new foveal or peripheral patch is fused with the "
+    "map's foveal and peripheral patches of its surface at any level, each weighed by its depth "
+    "sigma (the periphery is matched at full resolution too, over wider blocks; false: only with "
+    "patches of its level or finer; IDR patches are never fused into finer ones)"};
 inline constexpr ParamSpec kIntegrationRetireIdr{
     "integration.retire_idr",
     "beyond the paper: after each fixation, remove the IDR patches whose footprint in the IDR view "
