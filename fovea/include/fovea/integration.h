@@ -25,7 +25,8 @@ struct IntegrationOptions {
   double contradiction_share = 0.25;
   /// Beyond the paper: a new patch's corners are fused (inverse-variance
   /// mean along the viewing ray) with the map's depth there where the map
-  /// shows the same surface at the same or a finer level.
+  /// shows the same surface at the same or a finer level (at any foveal or
+  /// peripheral level with fuse_across_levels).
   bool fuse = true;
   /// Beyond the paper, with fuse: a new foveal or peripheral patch is fused
   /// with the map's foveal and peripheral patches of its surface whatever

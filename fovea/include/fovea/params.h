@@ -442,8 +442,8 @@ inline constexpr ParamSpec kIntegrationContradictionShare{
 inline constexpr ParamSpec kIntegrationFuse{
     "integration.fuse",
     "beyond the paper: fuse a new patch with the map's depth where the map shows the same surface "
-    "at the same or a "
-    "finer level (inverse-variance mean; false: the paper's replacement only)"};
+    "at the same or a finer level, or at any foveal or peripheral level with "
+    "integration.fuse_across_levels (inverse-variance mean; false: the paper's replacement only)"};
 inline constexpr ParamSpec kIntegrationFuseAcrossLevels{
     "integration.fuse_across_levels",
     "beyond the paper: with integration.fuse, a new foveal or peripheral patch is fused with the "
